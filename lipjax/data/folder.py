@@ -1,0 +1,208 @@
+"""Image / depth file readers, and a data set over a user's own folder of RGB-D frames.
+
+Folder layout (frames matched by file stem):
+
+    <root>/rgb/<stem>.png|.jpg|.jpeg          colour image (any bit depth; read as 8-bit RGB)
+    <root>/depth/<stem>.png                   16-bit depth, metres = value / depth_scale, 0 = invalid
+    <root>/depth/<stem>.npy                   float depth in metres (0 = invalid)
+    <root>/intrinsics.txt                     optional: "fx fy cx cy" or the 9 numbers of K (row-major)
+    <root>/intrinsics/<stem>.txt              optional, per frame, same format
+
+Depth scales of common sensors (raw PNG value per metre): KITTI 256, NYU / Kinect / RealSense 1000,
+TUM RGB-D 5000. A PNG depth has no unit in it, so the scale must be given: there is no default.
+"""
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from lipjax.data.errors import dataset_error
+from lipjax.data.sample import Intrinsics, Sample
+
+RGB_SUFFIXES = (".png", ".jpg", ".jpeg")
+DEPTH_SUFFIXES = (".png", ".npy")
+KNOWN_DEPTH_SCALES = {"kitti": 256.0, "nyu": 1000.0, "tum": 5000.0}
+
+FOLDER_LAYOUT = """\
+<root>/rgb/<stem>.png|.jpg
+<root>/depth/<stem>.png (16-bit, needs depth_scale) or <stem>.npy (float metres)
+<root>/intrinsics.txt ("fx fy cx cy" or 9 numbers of K)  or  <root>/intrinsics/<stem>.txt"""
+FOLDER_SOURCE = "your own frames (lipjax.data.folder.FolderDataset)"
+
+_DIGITS = re.compile(r"(\d+)")
+
+
+def natural_key(text: str) -> tuple:
+    """Sort key ordering embedded integers numerically ("2" < "10"), so listings are stable and human-ordered."""
+    return tuple(int(tok) if tok.isdigit() else tok for tok in _DIGITS.split(text))
+
+
+def read_rgb(path: str | os.PathLike) -> np.ndarray:
+    """Reads a colour image as (H, W, 3) uint8 RGB (cv2 decodes BGR; converted here). Grey images get 3 channels."""
+    image = cv2.imread(os.fspath(path), cv2.IMREAD_COLOR)
+    if image is None:
+        raise dataset_error("Cannot read RGB image (missing, corrupt or unsupported format)", path)
+    return np.ascontiguousarray(cv2.cvtColor(image, cv2.COLOR_BGR2RGB))
+
+
+def read_depth(path: str | os.PathLike, scale: float | None = None) -> np.ndarray:
+    """Reads a depth map as (H, W) float32 metres, 0 = invalid.
+
+    Formats:
+      .png: 16-bit unsigned; metres = value / scale. `scale` is required (KITTI 256, NYU 1000, TUM 5000).
+        8-bit PNGs are rejected: they cannot hold metric depth and usually mean a visualisation was saved.
+      .npy: float or integer array (H, W) or (H, W, 1); metres = value / scale, scale defaults to 1 (metres).
+
+    Raises DatasetError on an unreadable file, a wrong dtype / shape, or NaN / infinite / negative values
+    (0 is the only invalid marker inside the library, so other markers are refused rather than guessed).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if scale is not None and not scale > 0:
+        raise dataset_error(f"Depth scale must be > 0, got {scale}", path)
+    if suffix == ".npy":
+        try:
+            raw = np.load(path, allow_pickle=False)
+        except Exception as exc:  # noqa: BLE001 - any failure to decode is the same user-facing problem
+            raise dataset_error(f"Cannot read depth .npy ({type(exc).__name__}: {exc})", path) from exc
+        if raw.ndim == 3 and raw.shape[2] == 1:
+            raw = raw[..., 0]
+        if raw.ndim != 2 or not (np.issubdtype(raw.dtype, np.floating) or np.issubdtype(raw.dtype, np.integer)):
+            raise dataset_error(f"Depth .npy must be a numeric (H, W) array, got {raw.dtype} {raw.shape}", path)
+        depth = raw.astype(np.float32) / np.float32(1.0 if scale is None else scale)
+    elif suffix == ".png":
+        if scale is None:
+            raise dataset_error(
+                "A PNG depth map needs a depth scale (metres = value / scale; e.g. KITTI 256, NYU 1000, TUM 5000), "
+                "none was given for",
+                path,
+            )
+        raw = cv2.imread(os.fspath(path), cv2.IMREAD_UNCHANGED)
+        if raw is None:
+            raise dataset_error("Cannot read depth PNG (missing, corrupt or not an image)", path)
+        if raw.dtype != np.uint16 or raw.ndim != 2:
+            raise dataset_error(f"Depth PNG must be single-channel 16-bit, got {raw.dtype} with shape {raw.shape}", path)
+        depth = raw.astype(np.float32) / np.float32(scale)
+    else:
+        raise dataset_error(f"Unsupported depth format {suffix!r} (use .png with a scale, or .npy in metres)", path)
+    if not np.all(np.isfinite(depth)):
+        raise dataset_error("Depth contains NaN or infinite values (use 0 to mark invalid pixels)", path)
+    if np.any(depth < 0):
+        raise dataset_error("Depth contains negative values (use 0 to mark invalid pixels)", path)
+    return depth
+
+
+def read_intrinsics_txt(path: str | os.PathLike) -> Intrinsics:
+    """Reads "fx fy cx cy" (4 numbers) or a row-major 3x3 K (9 numbers), any whitespace, in pixels."""
+    try:
+        values = [float(tok) for tok in Path(path).read_text().split()]
+    except (OSError, ValueError) as exc:
+        raise dataset_error(f"Cannot read intrinsics ({exc})", path) from exc
+    if len(values) == 4:
+        return Intrinsics(*values)
+    if len(values) == 9:
+        k = np.asarray(values).reshape(3, 3)
+        return Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]))
+    raise dataset_error(f"Intrinsics file must hold 4 numbers (fx fy cx cy) or 9 (K), found {len(values)}", path)
+
+
+def _list(directory: Path, suffixes: tuple[str, ...]) -> dict[str, Path]:
+    found: dict[str, Path] = {}
+    for path in sorted(directory.iterdir()):
+        if path.is_file() and path.suffix.lower() in suffixes:
+            if path.stem in found:
+                raise dataset_error(f"Two files share the stem {path.stem!r} ({found[path.stem].name})", path, FOLDER_LAYOUT)
+            found[path.stem] = path
+    return found
+
+
+def _trailing_number(stem: str) -> str | None:
+    match = re.search(r"(\d+)$", stem)
+    return match.group(1) if match else None
+
+
+class FolderDataset:
+    """A user's folder of RGB-D frames (layout in the module docstring), as Samples sorted by stem.
+
+    Frames are matched by file stem. When no stem matches exactly, frames are matched by the trailing number
+    of the stem instead (so BTS-style "rgb_00050.jpg" pairs with "sync_depth_00050.png"). Every RGB image
+    must have a depth map and vice versa; anything else is an error rather than a silent skip.
+
+    Args:
+      root: the folder holding rgb/ and depth/.
+      depth_scale: raw PNG value per metre (required when any depth file is a PNG).
+      intrinsics: overrides intrinsics files; otherwise root/intrinsics.txt, else root/intrinsics/<stem>.txt.
+      id_prefix: Sample.id = f"{id_prefix}/{stem}"; defaults to "folder/<root name>".
+    """
+
+    def __init__(self, root: str | os.PathLike, depth_scale: float | None = None,
+                 intrinsics: Intrinsics | None = None, id_prefix: str | None = None):
+        self.root = Path(root)
+        rgb_dir, depth_dir = self.root / "rgb", self.root / "depth"
+        for directory in (rgb_dir, depth_dir):
+            if not directory.is_dir():
+                raise dataset_error("Folder data set directory not found", directory, FOLDER_LAYOUT, FOLDER_SOURCE)
+        rgbs, depths = _list(rgb_dir, RGB_SUFFIXES), _list(depth_dir, DEPTH_SUFFIXES)
+        if not rgbs:
+            raise dataset_error("No RGB images (.png/.jpg) found", rgb_dir, FOLDER_LAYOUT, FOLDER_SOURCE)
+        if not set(rgbs) & set(depths):
+            rgbs = self._rekey_by_number(rgbs, rgb_dir)
+            depths = self._rekey_by_number(depths, depth_dir)
+        missing = sorted(set(rgbs) ^ set(depths), key=natural_key)
+        if missing:
+            side = [str(rgbs.get(k) or depths.get(k)) for k in missing[:5]]
+            raise dataset_error(f"{len(missing)} frame(s) have no RGB/depth partner, e.g. {side}", self.root, FOLDER_LAYOUT)
+        self.keys = sorted(rgbs, key=natural_key)
+        self.rgb_paths = [rgbs[k] for k in self.keys]
+        self.depth_paths = [depths[k] for k in self.keys]
+        pngs = [p for p in self.depth_paths if p.suffix.lower() == ".png"]
+        if pngs and depth_scale is None:
+            raise dataset_error(
+                "PNG depth maps need depth_scale (metres = value / scale; KITTI 256, NYU 1000, TUM 5000), e.g.",
+                pngs[0], FOLDER_LAYOUT,
+            )
+        self.depth_scale = depth_scale
+        self.intrinsics = intrinsics
+        if self.intrinsics is None and (self.root / "intrinsics.txt").is_file():
+            self.intrinsics = read_intrinsics_txt(self.root / "intrinsics.txt")
+        if self.intrinsics is None and not (self.root / "intrinsics").is_dir():
+            raise dataset_error(
+                "No intrinsics: pass intrinsics=..., or write intrinsics.txt (fx fy cx cy) or intrinsics/<stem>.txt in",
+                self.root, FOLDER_LAYOUT,
+            )
+        self.id_prefix = id_prefix if id_prefix is not None else f"folder/{self.root.resolve().name}"
+
+    @staticmethod
+    def _rekey_by_number(files: dict[str, Path], directory: Path) -> dict[str, Path]:
+        out: dict[str, Path] = {}
+        for stem, path in files.items():
+            number = _trailing_number(stem)
+            if number is None or number in out:
+                raise dataset_error("Cannot match frames: stems differ between rgb/ and depth/ and do not end in "
+                                    "unique numbers, e.g.", path, FOLDER_LAYOUT)
+            out[number] = path
+        return out
+
+    def __len__(self) -> int:
+        return len(self.keys)
+
+    def __getitem__(self, index: int) -> Sample:
+        key = self.keys[index]
+        rgb = read_rgb(self.rgb_paths[index])
+        scale = self.depth_scale if self.depth_paths[index].suffix.lower() == ".png" else None
+        depth = read_depth(self.depth_paths[index], scale)
+        if depth.shape != rgb.shape[:2]:
+            raise dataset_error(
+                f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ for frame {key!r}", self.depth_paths[index]
+            )
+        intrinsics = self.intrinsics
+        if intrinsics is None:
+            per_frame = self.root / "intrinsics" / f"{self.rgb_paths[index].stem}.txt"
+            if not per_frame.is_file():
+                raise dataset_error("Per-frame intrinsics file not found", per_frame, FOLDER_LAYOUT)
+            intrinsics = read_intrinsics_txt(per_frame)
+        return Sample.from_depth(rgb, depth, intrinsics, f"{self.id_prefix}/{key}")

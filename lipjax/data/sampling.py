@@ -1,0 +1,341 @@
+"""Sparse depth samplers: which ground-truth pixels become the sparse input y (mask m = y > 0).
+
+Every sampler is a frozen dataclass called as `sampler(sample, seed=0) -> (H, W) float32` sparse depth in
+metres, 0 = no sample. Randomness comes only from `example_rng(seed, sample.id)`, a numpy Generator seeded
+with sha256(f"{seed}/{sample.id}"): an example gets the same points in every run, process and data order,
+and "200 points" means the same 200 points at training, validation and test time.
+
+Samplers:
+  UniformSampler(n)     exactly n valid pixels, uniformly without replacement.
+  BernoulliSampler(n)   each valid pixel kept with probability n / #valid (Ma & Karaman 2018).
+  LidarSampler(...)     the scan pattern of a spinning multi-beam LiDAR (presets hdl64, hdl32, vlp32, vlp16).
+  Noisy(sampler, noise) any sampler followed by a Noise model.
+
+`sampler_from_spec("uniform:200")` builds one from a string (CLIs, configs); grammar in its docstring.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import math
+from typing import Protocol
+
+import numpy as np
+
+from lipjax.data.sample import Sample
+
+# A noisy sample must stay > 0: 0 means "no sample" and would silently drop the point.
+MIN_SPARSE_DEPTH_M = 1e-3
+
+
+class SparseSampler(Protocol):
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray: ...
+
+
+def example_rng(seed: int, sample_id: str, stream: str = "") -> np.random.Generator:
+    """numpy Generator keyed by sha256(f"{seed}/{sample_id}") (plus f"/{stream}" for an independent stream)."""
+    key = f"{seed}/{sample_id}" + (f"/{stream}" if stream else "")
+    digest = hashlib.sha256(key.encode("utf-8")).digest()
+    return np.random.Generator(np.random.PCG64(int.from_bytes(digest[:16], "little")))
+
+
+def subsample_exact(depth: np.ndarray, num_points: int, rng: np.random.Generator) -> np.ndarray:
+    """Keeps exactly min(num_points, #measured) of the measured (> 0) pixels of `depth`, uniformly.
+
+    Args:
+      depth: (H, W) depth in metres, 0 = no measurement (a GT map, or a real LiDAR image).
+    Returns:
+      (H, W) float32, the kept pixels' depth and 0 elsewhere. When fewer than num_points pixels are measured,
+      all of them are kept (there is nothing else to give).
+    """
+    if num_points < 0:
+        raise ValueError(f"num_points must be >= 0, got {num_points}")
+    flat = np.asarray(depth, dtype=np.float32).reshape(-1)
+    candidates = np.flatnonzero(flat > 0)
+    if candidates.size > num_points:
+        candidates = candidates[rng.choice(candidates.size, size=num_points, replace=False)]
+    out = np.zeros_like(flat)
+    out[candidates] = flat[candidates]
+    return out.reshape(np.shape(depth))
+
+
+@dataclasses.dataclass(frozen=True)
+class UniformSampler:
+    """Exactly `num_points` valid ground-truth pixels, uniformly without replacement (all valid pixels when
+    there are fewer than num_points)."""
+
+    num_points: int
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        return subsample_exact(np.where(sample.valid, sample.depth, 0), self.num_points, example_rng(seed, sample.id))
+
+
+@dataclasses.dataclass(frozen=True)
+class BernoulliSampler:
+    """Each valid pixel kept independently with probability num_points / #valid (Ma & Karaman 2018's protocol):
+    num_points only on average."""
+
+    num_points: int
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        valid = sample.valid & (sample.depth > 0)
+        n_valid = int(valid.sum())
+        prob = min(1.0, self.num_points / n_valid) if n_valid else 0.0
+        keep = valid & (example_rng(seed, sample.id).random(sample.shape) < prob)
+        return np.where(keep, sample.depth, 0).astype(np.float32)
+
+
+@dataclasses.dataclass(frozen=True)
+class LidarSampler:
+    """A spinning multi-beam LiDAR's pattern, simulated on the valid ground truth.
+
+    Every valid pixel is back-projected with the intrinsics (camera frame: x right, y down, z forward, metres),
+    moved into the LiDAR frame, and given an elevation (angle above the LiDAR's horizontal plane) and an
+    azimuth (about its vertical axis). Elevation is quantised to the nearest beam, azimuth to multiples of
+    azimuth_step_deg; each (beam, azimuth) cell keeps the one pixel nearest (in angle) to the cell centre,
+    i.e. the pixel the ray would hit; a cell whose ray misses every valid pixel (it leaves the image, or lands
+    on invalid ground truth) keeps none. The result: one scan line per beam that falls in the camera's view,
+    with about (horizontal FOV / azimuth_step_deg) points per line.
+
+    Occlusion differences due to the camera-LiDAR baseline are not simulated (only camera-visible pixels exist).
+
+    Attributes:
+      beams: number of lasers.
+      vertical_fov_deg: (lowest, highest) beam elevation, degrees; beams equally spaced in between (the real
+        HDL-64E / VLP-32C spacings are not uniform: an approximation).
+      azimuth_step_deg: horizontal angular resolution (0.08 - 0.4 deg, depends on the spin rate).
+      max_range_m: returns farther than this are dropped.
+      mount_height_m: LiDAR origin above the camera centre (metres).
+      mount_forward_m: LiDAR origin ahead of the camera centre (negative: behind).
+      mount_pitch_deg: LiDAR tilt about the camera x axis, positive = tilted up.
+      dropout: fraction of returns lost at random (dark / specular surfaces), drawn from example_rng.
+    """
+
+    beams: int
+    vertical_fov_deg: tuple[float, float]
+    azimuth_step_deg: float = 0.2
+    max_range_m: float = 120.0
+    mount_height_m: float = 0.0
+    mount_forward_m: float = 0.0
+    mount_pitch_deg: float = 0.0
+    dropout: float = 0.0
+
+    # KITTI rig: Velodyne 1.73 m above ground, cameras 1.65 m, Velodyne 0.27 m behind the cameras.
+    KITTI_MOUNT = {"mount_height_m": 0.08, "mount_forward_m": -0.27, "mount_pitch_deg": 0.0}
+
+    @classmethod
+    def hdl64(cls, **overrides) -> "LidarSampler":
+        """Velodyne HDL-64E (KITTI): 64 beams, +2.0 .. -24.8 deg, 0.17 deg at 10 Hz, KITTI mounting."""
+        return cls(**{"beams": 64, "vertical_fov_deg": (-24.8, 2.0), "azimuth_step_deg": 0.17,
+                      "max_range_m": 120.0, **cls.KITTI_MOUNT, **overrides})
+
+    @classmethod
+    def hdl32(cls, **overrides) -> "LidarSampler":
+        """Velodyne HDL-32E: 32 beams, +10.67 .. -30.67 deg, 0.16 deg at 10 Hz, KITTI-like mounting."""
+        return cls(**{"beams": 32, "vertical_fov_deg": (-30.67, 10.67), "azimuth_step_deg": 0.16,
+                      "max_range_m": 100.0, **cls.KITTI_MOUNT, **overrides})
+
+    @classmethod
+    def vlp32(cls, **overrides) -> "LidarSampler":
+        """Velodyne VLP-32C: 32 beams, +15 .. -25 deg, 0.2 deg at 10 Hz, KITTI-like mounting."""
+        return cls(**{"beams": 32, "vertical_fov_deg": (-25.0, 15.0), "azimuth_step_deg": 0.2,
+                      "max_range_m": 200.0, **cls.KITTI_MOUNT, **overrides})
+
+    @classmethod
+    def vlp16(cls, **overrides) -> "LidarSampler":
+        """Velodyne VLP-16 (Puck): 16 beams, +15 .. -15 deg (2 deg apart), 0.2 deg at 10 Hz, KITTI-like mounting."""
+        return cls(**{"beams": 16, "vertical_fov_deg": (-15.0, 15.0), "azimuth_step_deg": 0.2,
+                      "max_range_m": 100.0, **cls.KITTI_MOUNT, **overrides})
+
+    def __post_init__(self):
+        lo, hi = self.vertical_fov_deg
+        if self.beams < 1 or (self.beams > 1 and not hi > lo) or self.azimuth_step_deg <= 0:
+            raise ValueError(f"invalid LiDAR parameters: {self}")
+        if not 0.0 <= self.dropout < 1.0:
+            raise ValueError(f"dropout must be in [0, 1), got {self.dropout}")
+
+    def beam_elevations_deg(self) -> np.ndarray:
+        """(beams,) elevation of each laser in degrees, lowest first."""
+        lo, hi = self.vertical_fov_deg
+        return np.linspace(lo, hi, self.beams) if self.beams > 1 else np.array([lo])
+
+    def angles(self, sample: Sample) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Flat indices of the valid pixels and their LiDAR-frame (elevation, azimuth) in radians and range (m)."""
+        idx = np.flatnonzero(sample.valid & (sample.depth > 0))
+        v, u = np.divmod(idx, sample.shape[1])
+        z = sample.depth.reshape(-1)[idx].astype(np.float64)
+        k = sample.intrinsics
+        x = (u - k.cx) / k.fx * z
+        y = (v - k.cy) / k.fy * z
+        # Camera frame -> LiDAR-origin frame: translate, then rotate about x by the pitch.
+        y = y + self.mount_height_m
+        z = z - self.mount_forward_m
+        p = math.radians(self.mount_pitch_deg)
+        # LiDAR axes in camera coordinates: forward = (0, -sin p, cos p), down = (0, cos p, sin p).
+        y_l = math.cos(p) * y + math.sin(p) * z
+        z_l = -math.sin(p) * y + math.cos(p) * z
+        horizontal = np.hypot(x, z_l)
+        elevation = np.arctan2(-y_l, horizontal)
+        azimuth = np.arctan2(x, z_l)
+        return idx, elevation, azimuth, np.sqrt(horizontal**2 + y_l**2)
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        idx, elevation, azimuth, rng_m = self.angles(sample)
+        beams = np.radians(self.beam_elevations_deg())
+        # A single beam has no spacing: give it an (arbitrary) band of +-0.2 deg.
+        spacing = (beams[-1] - beams[0]) / (self.beams - 1) if self.beams > 1 else math.radians(0.4)
+        # Nearest beam; pixels more than half a spacing outside the fan are dropped below.
+        beam = np.clip(np.rint((elevation - beams[0]) / spacing), 0, self.beams - 1).astype(np.int64)
+        d_el = elevation - beams[beam]
+        step = math.radians(self.azimuth_step_deg)
+        column = np.rint(azimuth / step).astype(np.int64)
+        d_az = (azimuth - column * step) * np.cos(elevation)
+        # A ray hits the pixel that contains it: a pixel more than about half its own angular size away from
+        # the cell centre is not hit (the ray leaves the image or falls on invalid ground truth). Local pixel
+        # pitch of the camera ray angles: d(elevation)/dv and d(azimuth)/du at this pixel (+10 % margin).
+        v, u = np.divmod(idx, sample.shape[1])
+        k = sample.intrinsics
+        dx, dy = (u - k.cx) / k.fx, (v - k.cy) / k.fy
+        el_pitch = np.sqrt(dx**2 + 1) / (dx**2 + dy**2 + 1) / k.fy
+        az_pitch = 1.0 / (dx**2 + 1) / k.fx
+        keep = (
+            (np.abs(d_el) <= spacing / 2)
+            & (np.abs(d_el) <= 0.55 * el_pitch)
+            & (np.abs(azimuth - column * step) <= 0.55 * az_pitch)
+            & (rng_m <= self.max_range_m)
+        )
+        idx, beam, column, cost = idx[keep], beam[keep], column[keep], (d_el**2 + d_az**2)[keep]
+        if idx.size == 0:
+            return np.zeros(sample.shape, dtype=np.float32)
+        column = column - column.min()
+        cell = beam * (int(column.max()) + 1) + column
+        order = np.lexsort((idx, cost, cell))  # per cell: nearest to the centre first; ties by pixel index
+        first = np.ones(order.size, dtype=bool)
+        first[1:] = cell[order][1:] != cell[order][:-1]
+        chosen = idx[order[first]]
+        if self.dropout > 0 and chosen.size:
+            chosen = chosen[example_rng(seed, sample.id).random(chosen.size) >= self.dropout]
+        out = np.zeros(sample.depth.size, dtype=np.float32)
+        out[chosen] = sample.depth.reshape(-1)[chosen]
+        return out.reshape(sample.shape)
+
+
+@dataclasses.dataclass(frozen=True)
+class Noise:
+    """Measurement noise applied to the sampled points only (zeros stay zeros).
+
+    Per point with depth d: d + N(0, std_m^2 + (relative_std * d)^2); then exactly
+    round(outlier_fraction * #points) points are replaced by outliers uniform in outlier_range_m (default: the
+    [min, max] of the example's valid ground truth). Results are clamped to >= MIN_SPARSE_DEPTH_M so no point
+    disappears. Randomness: example_rng(seed, sample_id, "noise"), independent of the sampler's draws.
+
+    Attributes:
+      std_m: additive Gaussian std in metres.
+      relative_std: range-proportional std, a fraction of depth (e.g. 0.01 = 1 %).
+      outlier_fraction: fraction of the sampled points replaced by outliers, in [0, 1].
+      outlier_range_m: (low, high) metres for outliers, or None for the example's GT range.
+    """
+
+    std_m: float = 0.0
+    relative_std: float = 0.0
+    outlier_fraction: float = 0.0
+    outlier_range_m: tuple[float, float] | None = None
+
+    def __post_init__(self):
+        if self.std_m < 0 or self.relative_std < 0 or not 0 <= self.outlier_fraction <= 1:
+            raise ValueError(f"invalid noise parameters: {self}")
+
+    def __call__(self, sparse: np.ndarray, sample: Sample, seed: int = 0) -> np.ndarray:
+        """(H, W) sparse metres -> (H, W) float32 noisy sparse metres, same support."""
+        rng = example_rng(seed, sample.id, "noise")
+        out = np.array(sparse, dtype=np.float32, copy=True)
+        idx = np.flatnonzero(out > 0)
+        flat = out.reshape(-1)
+        d = flat[idx].astype(np.float64)
+        std = np.sqrt(self.std_m**2 + (self.relative_std * d) ** 2)
+        d = d + rng.standard_normal(d.size) * std
+        n_out = int(round(self.outlier_fraction * idx.size))
+        if n_out:
+            if self.outlier_range_m is not None:
+                low, high = self.outlier_range_m
+            else:
+                gt = sample.depth[sample.valid]
+                low, high = (float(gt.min()), float(gt.max())) if gt.size else (MIN_SPARSE_DEPTH_M, 1.0)
+            which = rng.choice(idx.size, size=n_out, replace=False)
+            d[which] = rng.uniform(low, high, size=n_out)
+        flat[idx] = np.maximum(d, MIN_SPARSE_DEPTH_M).astype(np.float32)
+        return out
+
+
+@dataclasses.dataclass(frozen=True)
+class Noisy:
+    """`sampler` followed by `noise`: same call signature as a sampler."""
+
+    sampler: SparseSampler
+    noise: Noise
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        return self.noise(self.sampler(sample, seed), sample, seed)
+
+
+LIDAR_PRESETS = {"hdl64": LidarSampler.hdl64, "hdl32": LidarSampler.hdl32,
+                 "vlp32": LidarSampler.vlp32, "vlp16": LidarSampler.vlp16}
+_NOISE_KEYS = {"std": "std_m", "rel": "relative_std", "outliers": "outlier_fraction"}
+
+
+def _parse_options(text: str, spec: str) -> dict[str, float]:
+    options = {}
+    for item in filter(None, text.split(",")):
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ValueError(f"bad option {item!r} in sampler spec {spec!r} (expected key=value)")
+        try:
+            options[key.strip()] = float(value)
+        except ValueError:
+            raise ValueError(f"option {key!r} in sampler spec {spec!r} must be a number, got {value!r}") from None
+    return options
+
+
+def sampler_from_spec(spec: str) -> SparseSampler:
+    """Builds a sampler from a string.
+
+    Grammar: KIND[+noise:OPTIONS] with KIND one of
+      uniform:N                       UniformSampler(N)
+      bernoulli:N                     BernoulliSampler(N)
+      lidar:PRESET[,key=value...]     LidarSampler.PRESET(key=value), PRESET in hdl64 hdl32 vlp32 vlp16,
+                                      keys: any float field, e.g. azimuth_step_deg=0.4,mount_pitch_deg=-2
+    and noise OPTIONS std=<m>,rel=<fraction>,outliers=<fraction>.
+    Examples: "uniform:200", "bernoulli:500", "lidar:vlp16", "lidar:hdl64+noise:std=0.02,outliers=0.01".
+    """
+    base, _, noise_text = spec.strip().partition("+")
+    kind, _, arg = base.partition(":")
+    kind = kind.strip().lower()
+    sampler: SparseSampler
+    if kind in ("uniform", "bernoulli"):
+        try:
+            n = int(arg)
+        except ValueError:
+            raise ValueError(f"sampler spec {spec!r}: {kind} needs an integer point count, e.g. '{kind}:200'") from None
+        sampler = UniformSampler(n) if kind == "uniform" else BernoulliSampler(n)
+    elif kind == "lidar":
+        preset, _, options = arg.partition(",")
+        if preset not in LIDAR_PRESETS:
+            raise ValueError(f"sampler spec {spec!r}: unknown LiDAR preset {preset!r}; known: {sorted(LIDAR_PRESETS)}")
+        fields = {f.name for f in dataclasses.fields(LidarSampler)} - {"beams", "vertical_fov_deg"}
+        overrides = _parse_options(options, spec)
+        unknown = set(overrides) - fields
+        if unknown:
+            raise ValueError(f"sampler spec {spec!r}: unknown LiDAR option(s) {sorted(unknown)}; known: {sorted(fields)}")
+        sampler = LIDAR_PRESETS[preset](**overrides)
+    else:
+        raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N or lidar:{'|'.join(LIDAR_PRESETS)}")
+    if noise_text:
+        name, _, options = noise_text.partition(":")
+        if name.strip() != "noise":
+            raise ValueError(f"sampler spec {spec!r}: expected '+noise:...' after the sampler")
+        raw = _parse_options(options, spec)
+        unknown = set(raw) - set(_NOISE_KEYS)
+        if unknown:
+            raise ValueError(f"sampler spec {spec!r}: unknown noise option(s) {sorted(unknown)}; known: {sorted(_NOISE_KEYS)}")
+        sampler = Noisy(sampler, Noise(**{_NOISE_KEYS[k]: v for k, v in raw.items()}))
+    return sampler

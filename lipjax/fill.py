@@ -1,0 +1,52 @@
+"""A cheap, jit-able dense initial guess from sparse depth: multi-scale normalised box convolution.
+
+For growing box radii r = 1, 2, 4, ... the estimate at a pixel is sum(w * y) / sum(w) over its (2r+1)^2 window;
+each pixel takes the estimate of the smallest window that holds at least one sample. The result is a
+piecewise-smooth fill (close to a nearest-neighbour fill, but averaged), computed with cumulative sums in
+O(H W log max(H, W)). It is used as ADMM's z_0 so that the first learned prox refines a dense map instead of
+inventing depth from isolated points; measured pixels are restored exactly by the x-update anyway.
+"""
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+
+
+def _window_sum(a: jax.Array, radius: int, axis: int) -> jax.Array:
+    """Sum over [i - radius, i + radius] along `axis`, treating outside the image as zero."""
+    n = a.shape[axis]
+    c = jnp.cumsum(a, axis=axis)
+    pad = [(0, 0)] * a.ndim
+    pad[axis] = (1, 0)
+    c = jnp.pad(c, pad)
+    idx = jnp.arange(n)
+    hi = jnp.minimum(idx + radius + 1, n)
+    lo = jnp.maximum(idx - radius, 0)
+    return jnp.take(c, hi, axis=axis) - jnp.take(c, lo, axis=axis)
+
+
+def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
+    """Dense fill of sparse depth.
+
+    Args:
+      y: (..., H, W) sparse depth in metres, 0 where unmeasured.
+      weights: (..., H, W) mask or confidence weights >= 0.
+
+    Returns:
+      (..., H, W) dense depth in metres; 0 only where the whole image has no sample.
+    """
+    h, w = y.shape[-2:]
+    wy = weights * y
+    filled = jnp.zeros_like(y)
+    found = jnp.zeros(y.shape, dtype=bool)
+    radius = 1
+    while True:
+        num = _window_sum(_window_sum(wy, radius, -2), radius, -1)
+        den = _window_sum(_window_sum(weights, radius, -2), radius, -1)
+        has = den > 1e-6
+        filled = jnp.where(found | ~has, filled, num / jnp.where(has, den, 1.0))
+        found = found | has
+        if radius >= max(h, w):
+            break
+        radius *= 2
+    return filled

@@ -1,0 +1,134 @@
+"""The LIP model: wires the unrolled ADMM solver (lipjax.admm) to a prior (lipjax.priors) and a rho schedule.
+
+Parameters are a plain pytree:
+    {"prox": <prior params, stacked (K, ...) per iteration or one shared set>,
+     "log_rho": (K,) float32}                      # only when rho is learned; rho = exp(log_rho) > 0
+
+Inputs and outputs (see `apply`): rgb (B, H, W, 3) uint8 or float in [0, 1]; sparse depth (B, H, W) float32 in
+metres with 0 = no sample; output (B, H, W) float32 metres.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, Literal
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from lipjax.admm import Trajectory, unrolled_admm
+from lipjax.fill import box_fill
+from lipjax.priors.network import NetworkPrior, network_preset
+
+Params = Any
+InitialEstimate = Literal["sparse", "box_fill"]
+
+
+@dataclasses.dataclass(frozen=True)
+class LIPConfig:
+    """Everything that defines a LIP model except its learned parameters. Hashable (a static jit argument).
+
+    Attributes:
+      prior: the proximal operator (a frozen dataclass implementing lipjax.priors.base.Prior).
+      num_iterations: K, the number of unrolled ADMM iterations.
+      shared_prox: one prox parameter set for every iteration (the paper's future work) instead of one each.
+      rho_init: initial (or fixed) ADMM penalty, dimensionless, > 0; small rho trusts the measurements more.
+      learn_rho: learn one rho_k per iteration (kept positive as exp(log_rho)); else rho_k = rho_init.
+      initial_estimate: z_0. "sparse": z_0 = y (the paper). "box_fill": a multi-scale normalised box filter fill
+        (lipjax.fill), so the first learned prox refines a dense map; measured pixels are kept by the x-update.
+    """
+
+    prior: Any = dataclasses.field(default_factory=lambda: network_preset("small"))
+    num_iterations: int = 3
+    shared_prox: bool = False
+    rho_init: float = 0.1
+    learn_rho: bool = True
+    initial_estimate: InitialEstimate = "box_fill"
+
+    def __post_init__(self):
+        if self.num_iterations < 1:
+            raise ValueError(f"num_iterations must be >= 1, got {self.num_iterations}")
+        if not self.rho_init > 0:
+            raise ValueError(f"rho_init must be > 0, got {self.rho_init}")
+        if self.initial_estimate not in ("sparse", "box_fill"):
+            raise ValueError(f"initial_estimate must be 'sparse' or 'box_fill', got {self.initial_estimate!r}")
+
+
+def init(config: LIPConfig, key: jax.Array) -> Params:
+    """Random parameters: one prox set per iteration (independent keys), or one shared set."""
+    if config.shared_prox:
+        prox = config.prior.init(key)
+    else:
+        keys = jax.random.split(key, config.num_iterations)
+        prox = jax.vmap(config.prior.init)(keys)
+    params = {"prox": prox}
+    if config.learn_rho:
+        params["log_rho"] = jnp.full((config.num_iterations,), math.log(config.rho_init), jnp.float32)
+    return params
+
+
+def rho_schedule(config: LIPConfig, params: Params) -> jax.Array:
+    """(K,) positive ADMM penalties."""
+    if config.learn_rho:
+        return jnp.exp(params["log_rho"])
+    return jnp.full((config.num_iterations,), config.rho_init, jnp.float32)
+
+
+def _rgb_to_unit(rgb: jax.Array) -> jax.Array:
+    if rgb.dtype == jnp.uint8:
+        return rgb.astype(jnp.float32) / 255.0
+    return rgb.astype(jnp.float32)
+
+
+def apply(
+    config: LIPConfig,
+    params: Params,
+    rgb: jax.Array,
+    sparse: jax.Array,
+    weights: jax.Array | None = None,
+    *,
+    return_trajectory: bool = False,
+) -> tuple[jax.Array, Trajectory | None]:
+    """Completes depth. Pure and jit-able (config static); no input checks here (see lipjax.inference).
+
+    Args:
+      rgb: (B, H, W, 3) uint8, or float in [0, 1].
+      sparse: (B, H, W) float32 sparse depth in metres, 0 = no sample.
+      weights: (B, H, W) per-pixel confidence >= 0 (noise-aware data term); defaults to the mask sparse > 0.
+      return_trajectory: also return every iteration's (x, z), each (K, B, H, W).
+
+    Returns:
+      (depth (B, H, W) metres, Trajectory or None).
+    """
+    sparse = sparse.astype(jnp.float32)
+    if weights is None:
+        weights = (sparse > 0).astype(jnp.float32)
+    rgb = _rgb_to_unit(rgb)
+    z0 = box_fill(sparse, weights) if config.initial_estimate == "box_fill" else sparse
+    return unrolled_admm(
+        config.prior.apply,
+        params["prox"],
+        sparse,
+        weights,
+        rgb,
+        rho_schedule(config, params),
+        z0=z0,
+        shared_params=config.shared_prox,
+        return_trajectory=return_trajectory,
+    )
+
+
+def parameter_count(params: Params) -> int:
+    """Number of scalars in a parameter pytree (all iterations together)."""
+    return int(sum(np.prod(leaf.shape) for leaf in jax.tree_util.tree_leaves(params)))
+
+
+def presets(name: str) -> LIPConfig:
+    """Named model configurations: '<network preset>-<indoor|outdoor>', e.g. 'small-indoor', 'paper-outdoor'."""
+    try:
+        net, scene = name.split("-")
+        max_depth = {"indoor": 10.0, "outdoor": 85.0}[scene]
+    except (ValueError, KeyError):
+        raise ValueError(f"model preset must look like 'small-indoor' or 'paper-outdoor', got {name!r}") from None
+    return LIPConfig(prior=network_preset(net, max_depth_m=max_depth))

@@ -1,0 +1,90 @@
+"""The public inference entry point: clear input errors, batching, compile-once, save/load round trip."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+import lipjax
+from lipjax import inference, model_io
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+
+CONFIG = LIPConfig(prior=network_preset("tiny"), num_iterations=2)
+
+
+@pytest.fixture(scope="module")
+def completer():
+    return lipjax.Completer.random(CONFIG)
+
+
+def _inputs(h=16, w=20, seed=0, batch=None):
+    rng = np.random.default_rng(seed)
+    shape = (h, w) if batch is None else (batch, h, w)
+    rgb = rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
+    sparse = np.where(rng.random(shape) < 0.1, rng.uniform(1, 5, shape), 0).astype(np.float32)
+    sparse.reshape(-1, h, w)[:, 0, 0] = 2.0
+    return rgb, sparse
+
+
+def test_single_and_batched_calls_agree_and_keep_measurements(completer):
+    rgb, sparse = _inputs(batch=2)
+    batched = completer(rgb, sparse)
+    assert batched.shape == (2, 16, 20) and batched.dtype == np.float32
+    np.testing.assert_allclose(completer(rgb[1], sparse[1]), batched[1], rtol=1e-5)
+    m = sparse > 0
+    # rho = 0.1 and an identity prox: the measured pixels are reproduced.
+    np.testing.assert_allclose(batched[m], sparse[m], atol=1e-3)
+
+
+def test_compiled_once_per_shape(completer):
+    fn = inference._compiled(CONFIG, False)
+    for seed in range(3):
+        completer(*_inputs(seed=seed))
+    n = fn._cache_size()
+    completer(*_inputs(seed=9))
+    assert fn._cache_size() == n
+    completer(*_inputs(h=24, w=20))
+    assert fn._cache_size() == n + 1
+
+
+@pytest.mark.parametrize(
+    "mutate, message",
+    [
+        (lambda r, s: (r[:, :-1], s), "differ in size"),
+        (lambda r, s: (r[..., :2], s), "rgb must be"),
+        (lambda r, s: (r.astype(np.int32), s), "uint8"),
+        (lambda r, s: (r, np.where(s > 0, np.nan, 0).astype(np.float32)), "NaN"),
+        (lambda r, s: (r, -s), "negative"),
+        (lambda r, s: (r, np.zeros_like(s)), "no samples"),
+        (lambda r, s: (r, (s * 1000).astype(np.uint16)), "float metres"),
+        (lambda r, s: (r, s * 1000), "not metres"),
+    ],
+)
+def test_bad_input_gives_a_clear_error(completer, mutate, message):
+    rgb, sparse = _inputs()
+    with pytest.raises(lipjax.InputError, match=message):
+        completer(*mutate(rgb, sparse))
+
+
+def test_save_and_load_round_trip(tmp_path, completer):
+    model_io.save(tmp_path / "m", CONFIG, completer.params, {"note": "test"})
+    loaded = lipjax.load_model(tmp_path / "m.json")
+    assert loaded.config == CONFIG and loaded.metadata == {"note": "test"}
+    rgb, sparse = _inputs()
+    np.testing.assert_array_equal(loaded(rgb, sparse), completer(rgb, sparse))
+
+
+def test_unknown_model_name_lists_available():
+    with pytest.raises(ValueError, match="unknown model 'no-such-model'"):
+        lipjax.load_model("no-such-model")
+
+
+def test_fewer_iterations_uses_the_first_operators(completer):
+    short = completer.with_iterations(1)
+    assert short.config.num_iterations == 1
+    assert short.params["log_rho"].shape == (1,)
+    rgb, sparse = _inputs()
+    _, trajectory = completer.trajectory(rgb, sparse)
+    assert trajectory.x.shape == (2, 1, 16, 20)
+    with pytest.raises(ValueError):
+        completer.with_iterations(5)

@@ -1,0 +1,221 @@
+"""Sparse samplers: exact counts, determinism keyed by the example id, LiDAR scan lines, noise, spec parser."""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.sampling import (
+    BernoulliSampler,
+    LidarSampler,
+    Noise,
+    Noisy,
+    UniformSampler,
+    example_rng,
+    sampler_from_spec,
+)
+
+K_KITTI = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
+CAMERA_HEIGHT_M = 1.65
+
+
+def random_sample(id: str = "a", h: int = 60, w: int = 80, hole_fraction: float = 0.3) -> Sample:
+    rng = np.random.default_rng(0)  # same pixels for every id: only the id changes
+    depth = rng.uniform(0.5, 10.0, (h, w)).astype(np.float32)
+    depth[rng.random((h, w)) < hole_fraction] = 0
+    return Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), id)
+
+
+def plane_scene(wall_m: float = 60.0, h: int = 375, w: int = 1242) -> Sample:
+    """KITTI-like camera 1.65 m above a flat ground, looking level; a wall at wall_m fills the top."""
+    v = np.arange(h, dtype=np.float64)[:, None] * np.ones((1, w))
+    with np.errstate(divide="ignore"):
+        ground = np.where(v > K_KITTI.cy + 0.5, CAMERA_HEIGHT_M * K_KITTI.fy / (v - K_KITTI.cy), np.inf)
+    depth = np.minimum(ground, wall_m).astype(np.float32)
+    return Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, K_KITTI, "plane")
+
+
+def count_scan_lines(sparse: np.ndarray, half_width: int = 20) -> int:
+    """Distinct groups of rows hit in a central column strip (lines are near-horizontal there)."""
+    w = sparse.shape[1]
+    rows = np.flatnonzero((sparse[:, w // 2 - half_width : w // 2 + half_width] > 0).any(axis=1))
+    return 0 if rows.size == 0 else 1 + int(np.sum(np.diff(rows) > 1))
+
+
+def beams_in_view(sampler: LidarSampler, h: int = 375) -> int:
+    """Beams whose elevation (relative to the camera's optical axis) falls inside the image rows."""
+    top = np.degrees(np.arctan(K_KITTI.cy / K_KITTI.fy))
+    bottom = -np.degrees(np.arctan((h - 1 - K_KITTI.cy) / K_KITTI.fy))
+    el = sampler.beam_elevations_deg() + sampler.mount_pitch_deg
+    return int(np.sum((el < top) & (el > bottom)))
+
+
+# ---- uniform / bernoulli -------------------------------------------------------------------------------------
+
+
+def test_uniform_exact_count_valid_pixels_and_values():
+    sample = random_sample()
+    sparse = UniformSampler(200)(sample)
+    assert sparse.dtype == np.float32 and sparse.shape == sample.shape
+    assert np.count_nonzero(sparse) == 200
+    assert np.all(sample.valid[sparse > 0]) and np.array_equal(sparse[sparse > 0], sample.depth[sparse > 0])
+
+
+def test_uniform_fewer_valid_than_requested_keeps_all():
+    sample = random_sample(h=10, w=10, hole_fraction=0.5)
+    sparse = UniformSampler(500)(sample)
+    assert np.array_equal(sparse > 0, sample.valid)
+
+
+def test_uniform_deterministic_per_id_and_seed():
+    a, b = random_sample("a"), random_sample("b")  # same pixels, different ids
+    s = UniformSampler(100)
+    assert np.array_equal(s(a), s(a)) and np.array_equal(s(a, seed=3), s(a, seed=3))
+    assert not np.array_equal(s(a) > 0, s(b) > 0)
+    assert not np.array_equal(s(a) > 0, s(a, seed=1) > 0)
+
+
+def test_uniform_independent_of_process_and_hash_seed():
+    """The points depend on sha256(seed/id) only: another interpreter with another hash seed agrees."""
+    code = (
+        "import json, numpy as np\n"
+        "from lipjax.data.sample import Sample, Intrinsics\n"
+        "from lipjax.data.sampling import UniformSampler\n"
+        "s = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1,1,0,0), 'nyu/val/x/1')\n"
+        "print(json.dumps(np.flatnonzero(UniformSampler(25)(s, seed=7)).tolist()))\n"
+    )
+    env = {**os.environ, "PYTHONHASHSEED": "12345"}
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    here = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1, 1, 0, 0), "nyu/val/x/1")
+    assert json.loads(result.stdout) == np.flatnonzero(UniformSampler(25)(here, seed=7)).tolist()
+
+
+def test_example_rng_streams_differ():
+    assert example_rng(0, "x").random() == example_rng(0, "x").random()
+    assert example_rng(0, "x").random() != example_rng(0, "x", "noise").random()
+
+
+def test_bernoulli_count_on_average_and_valid_only():
+    sample = random_sample(h=200, w=300)
+    n_valid = int(sample.valid.sum())
+    counts = [np.count_nonzero(BernoulliSampler(500)(sample, seed=s)) for s in range(5)]
+    sd = np.sqrt(500 * (1 - 500 / n_valid))
+    assert all(abs(c - 500) < 5 * sd for c in counts) and len(set(counts)) > 1
+    sparse = BernoulliSampler(500)(sample)
+    assert np.all(sample.valid[sparse > 0]) and np.array_equal(sparse, BernoulliSampler(500)(sample))
+
+
+# ---- LiDAR -----------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("sampler", [LidarSampler(64, (-24.8, 2.0), 0.17), LidarSampler(16, (-15.0, 15.0), 0.2),
+                                     LidarSampler.hdl64(), LidarSampler.vlp16(), LidarSampler.vlp32()],
+                         ids=["hdl64-no-offset", "vlp16-no-offset", "hdl64", "vlp16", "vlp32"])
+def test_lidar_scan_lines_on_a_plane(sampler):
+    scene = plane_scene()
+    sparse = sampler(scene)
+    expected = beams_in_view(sampler)
+    assert abs(count_scan_lines(sparse) - expected) <= (0 if sampler.mount_height_m == 0 else 1)
+    assert np.all(scene.valid[sparse > 0]) and np.array_equal(sparse[sparse > 0], scene.depth[sparse > 0])
+    # About (horizontal field of view / azimuth step) points per line.
+    hfov = np.degrees(np.arctan(K_KITTI.cx / K_KITTI.fx) + np.arctan((1241 - K_KITTI.cx) / K_KITTI.fx))
+    per_line = np.count_nonzero(sparse) / expected
+    assert 0.85 * hfov / sampler.azimuth_step_deg <= per_line <= 1.02 * hfov / sampler.azimuth_step_deg
+
+
+def test_lidar_one_point_per_cell_and_nearest_to_beam():
+    scene = plane_scene()
+    sampler = LidarSampler(64, (-24.8, 2.0), 0.17)
+    sparse = sampler(scene)
+    idx, el, az, _ = sampler.angles(scene)
+    chosen = np.isin(idx, np.flatnonzero(sparse.reshape(-1)))
+    beams = np.radians(sampler.beam_elevations_deg())
+    spacing = beams[1] - beams[0]
+    beam = np.rint((el - beams[0]) / spacing).astype(int)
+    cells = beam[chosen] * 100000 + np.rint(az[chosen] / np.radians(0.17)).astype(int)
+    assert len(np.unique(cells)) == chosen.sum()  # at most one point per (beam, azimuth) cell
+    # Chosen points sit much closer to their beam than a random pixel of the band (which averages spacing/4).
+    assert np.mean(np.abs(el[chosen] - beams[beam[chosen]])) < spacing / 8
+
+
+def test_lidar_pitch_and_range():
+    scene = plane_scene()
+    tilted = LidarSampler(16, (-15.0, 15.0), 0.2, mount_pitch_deg=-6.0)  # tilted down: more beams see the image
+    assert count_scan_lines(tilted(scene)) == beams_in_view(tilted) != beams_in_view(LidarSampler(16, (-15.0, 15.0)))
+    short = LidarSampler(64, (-24.8, 2.0), 0.17, max_range_m=50.0)
+    sparse = short(scene)
+    assert sparse.max() <= 50.0 and not np.any(sparse == 60.0)
+
+
+def test_lidar_dropout_is_deterministic():
+    scene = plane_scene()
+    full = np.count_nonzero(LidarSampler.vlp16()(scene))
+    sampler = LidarSampler.vlp16(dropout=0.5)
+    a, b = sampler(scene, seed=1), sampler(scene, seed=1)
+    assert np.array_equal(a, b) and 0.4 * full < np.count_nonzero(a) < 0.6 * full
+    assert not np.array_equal(a, sampler(scene, seed=2))
+
+
+# ---- noise -----------------------------------------------------------------------------------------------------
+
+
+def test_noise_statistics_support_and_determinism():
+    sample = random_sample(h=200, w=300)
+    clean = UniformSampler(5000)(sample)
+    noisy = Noise(std_m=0.1)(clean, sample, seed=0)
+    support = clean > 0
+    assert np.array_equal(noisy > 0, support)
+    assert np.std(noisy[support] - clean[support]) == pytest.approx(0.1, rel=0.05)
+    assert np.array_equal(noisy, Noise(std_m=0.1)(clean, sample, seed=0))
+    rel = Noise(relative_std=0.05)(clean, sample)
+    ratio = (rel[support] - clean[support]) / clean[support]
+    assert np.std(ratio) == pytest.approx(0.05, rel=0.05)
+
+
+def test_noise_outliers_exact_fraction_and_positive():
+    sample = random_sample(h=100, w=100)
+    clean = UniformSampler(1000)(sample)
+    noisy = Noise(outlier_fraction=0.1, outlier_range_m=(20.0, 30.0))(clean, sample)
+    changed = noisy != clean
+    assert changed.sum() == 100 and np.all((noisy[changed] >= 20) & (noisy[changed] <= 30))
+    huge = Noise(std_m=50.0)(clean, sample)
+    assert np.array_equal(huge > 0, clean > 0) and huge[clean > 0].min() >= 1e-3
+
+
+def test_noisy_wrapper():
+    sample = random_sample()
+    s = Noisy(UniformSampler(50), Noise(std_m=0.2))
+    out = s(sample, seed=4)
+    assert np.array_equal(out > 0, UniformSampler(50)(sample, seed=4) > 0) and np.array_equal(out, s(sample, seed=4))
+
+
+# ---- spec parser -----------------------------------------------------------------------------------------------
+
+
+def test_sampler_from_spec():
+    assert sampler_from_spec("uniform:200") == UniformSampler(200)
+    assert sampler_from_spec("bernoulli:500") == BernoulliSampler(500)
+    assert sampler_from_spec("lidar:hdl64") == LidarSampler.hdl64()
+    assert sampler_from_spec("lidar:vlp16") == LidarSampler.vlp16()
+    s = sampler_from_spec("lidar:vlp32,azimuth_step_deg=0.4+noise:std=0.02,rel=0.01,outliers=0.05")
+    assert s == Noisy(dataclasses.replace(LidarSampler.vlp32(), azimuth_step_deg=0.4), Noise(0.02, 0.01, 0.05))
+    for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1", "uniform:3+blur:1"):
+        with pytest.raises(ValueError):
+            sampler_from_spec(bad)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 300), st.floats(0.0, 1.0), st.integers(0, 2**31 - 1))
+def test_uniform_count_is_min_of_n_and_valid(n, hole_fraction, seed):
+    sample = random_sample(h=12, w=15, hole_fraction=hole_fraction)
+    sparse = UniformSampler(n)(sample, seed=seed)
+    assert np.count_nonzero(sparse) == min(n, int(sample.valid.sum()))
+    assert np.all(sample.valid[sparse > 0])
