@@ -2,7 +2,10 @@ r"""Depth-completion metrics, with units in every name, and their data-set aggre
 
 Evaluated pixels of one image (the evaluation mask E):
 
-    E = valid & isfinite(gt) & (min_depth_m <= gt <= max_depth_m)
+    E = valid & isfinite(gt) & (min_depth_m < gt <= max_depth_m)
+
+(lower bound exclusive, upper inclusive: the convention of `lipjax.data.protocols.Protocol.eval_mask`, whose
+named protocols carry the ranges to pass here, e.g. NYU (0, 10] m, outdoor (0, 80] m).
 
 Per image, with d = prediction and g = ground truth (metres), over the pixels of E:
 
@@ -44,8 +47,8 @@ from typing import Any
 
 import numpy as np
 
-DEFAULT_MIN_DEPTH_M = 1e-3
-"""Default lower end of the evaluated ground-truth range, metres (excludes only zero / invalid depth)."""
+DEFAULT_MIN_DEPTH_M = 0.0
+"""Default lower end (exclusive) of the evaluated ground-truth range, metres: only gt = 0 / invalid is cut."""
 DEFAULT_MAX_DEPTH_M = math.inf
 """Default upper end of the evaluated ground-truth range, metres (no upper cut)."""
 DEFAULT_PRED_FLOOR_M = 1e-3
@@ -82,10 +85,10 @@ def _as_2d(name: str, a: Any, dtype) -> np.ndarray:
 def evaluation_mask(
     gt: np.ndarray, valid: np.ndarray, *, min_depth_m: float = DEFAULT_MIN_DEPTH_M, max_depth_m: float = DEFAULT_MAX_DEPTH_M
 ) -> np.ndarray:
-    """(H, W) bool mask E of the pixels that are scored: valid, finite ground truth within [min, max] metres."""
+    """(H, W) bool mask E of the pixels that are scored: valid, finite ground truth in (min, max] metres."""
     gt = np.asarray(gt)
     with np.errstate(invalid="ignore"):
-        return np.asarray(valid, dtype=bool) & np.isfinite(gt) & (gt >= min_depth_m) & (gt <= max_depth_m)
+        return np.asarray(valid, dtype=bool) & np.isfinite(gt) & (gt > min_depth_m) & (gt <= max_depth_m)
 
 
 def compute_metrics(
@@ -105,7 +108,7 @@ def compute_metrics(
       gt: (H, W) ground-truth depth, metres.
       valid: (H, W) bool, True where gt is trusted.
       sparse: optional (H, W) sparse input depth, metres, 0 where not sampled; enables the sampled metrics.
-      min_depth_m, max_depth_m: evaluated ground-truth range, metres, inclusive.
+      min_depth_m, max_depth_m: evaluated ground-truth range (min, max] in metres.
       pred_floor_m: floor applied to pred for delta and inverse metrics only, metres (> 0).
 
     Returns:
@@ -114,8 +117,8 @@ def compute_metrics(
     """
     if not pred_floor_m > 0:
         raise ValueError(f"pred_floor_m must be > 0 metres, got {pred_floor_m}")
-    if not min_depth_m <= max_depth_m:
-        raise ValueError(f"empty depth range [{min_depth_m}, {max_depth_m}] m")
+    if not min_depth_m < max_depth_m:
+        raise ValueError(f"empty depth range ({min_depth_m}, {max_depth_m}] m")
     d = _as_2d("pred", pred, np.float64)
     g = _as_2d("gt", gt, np.float64)
     v = _as_2d("valid", valid, bool)

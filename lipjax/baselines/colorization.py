@@ -13,8 +13,13 @@ at least 0.01 (2 sigma_r^2 >= min_s (Y_r - Y_s)^2 / ln 100), and never below 2e-
 
 Sampled pixels are hard constraints x_r = y_r (the toolbox uses a soft weight of 1; hard constraints give exact
 data consistency). Eliminating them leaves a sparse, row-diagonally-dominant (M-matrix) system on the unknown
-pixels, non-singular because the 8-connected grid links every pixel to a sample (all weights are > 0); it is
-solved with a direct sparse LU (SuperLU). Rows sum to zero, so a constant depth is reproduced exactly.
+pixels, non-singular because the 8-connected grid links every pixel to a sample (all weights are > 0). Rows sum
+to zero, so a constant depth is reproduced exactly.
+
+Solver: a direct sparse LU (SuperLU) on the unknowns ordered by geometric nested dissection of the pixel grid
+(`nested_dissection_order`), without pivoting (safe: every principal submatrix of a non-singular M-matrix is one).
+SuperLU's own COLAMD ordering fills twice as much on this 9-point stencil; measured on this 2-core machine at
+256x320 with 200 samples: ~0.4-0.6 s with nested dissection vs ~1.0-2.2 s with COLAMD.
 """
 from __future__ import annotations
 
@@ -58,6 +63,37 @@ def neighbour_weights(y: np.ndarray) -> np.ndarray:
     return np.where(nb_in, np.exp(-sq / two_sigma_sq), 0.0)
 
 
+def nested_dissection_order(h: int, w: int, leaf_size: int = 64) -> np.ndarray:
+    """A fill-reducing elimination order of the (h, w) pixel grid (flat indices), for 8-connected stencils.
+
+    Recursively splits the longer side by a one-pixel separator line, orders both halves first and the
+    separator last, so eliminating a half never couples to the other one (George 1973).
+    """
+    idx = np.arange(h * w).reshape(h, w)
+    out: list[np.ndarray] = []
+    stack = [(0, h, 0, w, False)]
+    # Explicit stack instead of recursion; a region is pushed again with emit_separator=True to emit its separator last.
+    while stack:
+        y0, y1, x0, x1, emit_separator = stack.pop()
+        hh, ww = y1 - y0, x1 - x0
+        if hh <= 0 or ww <= 0:
+            continue
+        if emit_separator:
+            if hh >= ww:
+                out.append(idx[(y0 + y1) // 2, x0:x1])
+            else:
+                out.append(idx[y0:y1, (x0 + x1) // 2])
+        elif hh * ww <= leaf_size:
+            out.append(idx[y0:y1, x0:x1].ravel())
+        elif hh >= ww:
+            m = (y0 + y1) // 2
+            stack += [(y0, y1, x0, x1, True), (m + 1, y1, x0, x1, False), (y0, m, x0, x1, False)]
+        else:
+            m = (x0 + x1) // 2
+            stack += [(y0, y1, x0, x1, True), (y0, y1, m + 1, x1, False), (y0, y1, x0, m, False)]
+    return np.concatenate(out)
+
+
 def colorization_fill(rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
     """rgb (H, W, 3) uint8, sparse (H, W) float32 metres (0 = no sample) -> (H, W) float32 dense metres."""
     h, w = sparse.shape
@@ -81,12 +117,15 @@ def colorization_fill(rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
     rows, cols, vals = (np.concatenate(a) for a in (rows, cols, vals))
     a = sp.csr_matrix((vals, (rows, cols)), shape=(h * w, h * w)) + sp.identity(h * w, format="csr")
 
-    unknown = ~known
+    order = nested_dissection_order(h, w)
+    unknown = order[~known[order]]  # unknown pixels, in elimination order
     y = sparse.ravel().astype(np.float64)
-    a_uu = a[unknown][:, unknown].tocsc()
-    rhs = -(a[unknown][:, known] @ y[known])
+    a_u = a[unknown]
+    a_uu = a_u[:, unknown].tocsc()
+    rhs = -(a_u[:, known] @ y[known])
+    lu = spla.splu(a_uu, permc_spec="NATURAL", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
     x = y.copy()
-    x[unknown] = spla.splu(a_uu, permc_spec="COLAMD").solve(rhs)
+    x[unknown] = lu.solve(rhs)
     return x.reshape(h, w).astype(np.float32)
 
 

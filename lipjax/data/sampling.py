@@ -296,7 +296,33 @@ def _parse_options(text: str, spec: str) -> dict[str, float]:
     return options
 
 
+@dataclasses.dataclass(frozen=True)
+class Mixture:
+    """Draws each example's sparse input from one of several samplers, chosen by the example's own key.
+
+    Training on a mixture of densities and patterns makes a model that holds up when a user's sensor differs
+    from the one it was trained for. The choice is a pure function of (seed, id), like every sampler here.
+    """
+
+    samplers: tuple[SparseSampler, ...]
+
+    def __post_init__(self):
+        if not self.samplers:
+            raise ValueError("Mixture needs at least one sampler")
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        choice = int(example_rng(seed, sample.id, "mixture").integers(len(self.samplers)))
+        return self.samplers[choice](sample, seed)
+
+
 def sampler_from_spec(spec: str) -> SparseSampler:
+    """Builds a sampler from a string; "A|B|C" is a Mixture of the samplers A, B and C (see `Mixture`)."""
+    if "|" in spec:
+        return Mixture(tuple(_single_sampler_from_spec(part) for part in spec.split("|")))
+    return _single_sampler_from_spec(spec)
+
+
+def _single_sampler_from_spec(spec: str) -> SparseSampler:
     """Builds a sampler from a string.
 
     Grammar: KIND[+noise:OPTIONS] with KIND one of

@@ -1,0 +1,56 @@
+"""Frames per second of the procedural renderer (lipjax.data.synthetic), one process, one core.
+
+Run by hand (not a test); pin to one core so the number means "per core":
+
+    taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py [--frames 40] [--split train]
+
+Prints frames/s for indoor and outdoor at 256x320 and 128x160: mean over `--frames` consecutive indices
+(different scenes) after 2 warm-up frames, whole `render()` calls (scene building, ray casting, shading,
+camera model, Sample construction).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+# numpy's elementwise work is single-threaded anyway; keep any BLAS pool from spreading over cores.
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
+from lipjax.data import synthetic  # noqa: E402
+
+SIZES = ((256, 320), (128, 160))
+
+
+def measure(kind: str, split: str, height: int, width: int, frames: int, start: int) -> tuple[float, float]:
+    """-> (frames per second, slowest frame in ms) over `frames` consecutive indices."""
+    for i in range(2):
+        synthetic.render(kind, split, start + frames + i, height, width)
+    worst = 0.0
+    t0 = time.perf_counter()
+    for i in range(start, start + frames):
+        t = time.perf_counter()
+        synthetic.render(kind, split, i, height, width)
+        worst = max(worst, time.perf_counter() - t)
+    return frames / (time.perf_counter() - t0), worst * 1e3
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--frames", type=int, default=40)
+    ap.add_argument("--split", default="train", choices=synthetic.SPLITS)
+    ap.add_argument("--start", type=int, default=0)
+    args = ap.parse_args(argv)
+    affinity = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else "?"
+    print(f"lipjax.data.synthetic: {args.frames} frames per row, split={args.split}, CPUs allowed: {affinity}")
+    for height, width in SIZES:
+        for kind in synthetic.SYNTHETIC_KINDS:
+            fps, worst = measure(kind, args.split, height, width, args.frames, args.start)
+            print(f"{kind:8s} {height:4d}x{width:<4d} {fps:7.1f} frames/s   (slowest frame {worst:6.1f} ms)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,83 @@
+"""Training configurations (configs are code). Each entry: what it trains, the command, the expected runtime.
+
+    python -m experiments.train --config lip_cnn_indoor            # ~1 h on 2 CPU cores
+    python -m experiments.train --config lip_ad_indoor             # needs lip_cnn_indoor's weights first
+    python -m experiments.train --config smoke                     # seconds after compilation: a check, not a model
+
+Shipped weights (lipjax/weights/<name>) come from these configs, trained on the embedded synthetic data:
+random 128x160 crops of 256x320 indoor renders, or 128x208 crops of 128x416 outdoor (KITTI-aspect) renders,
+with a mixture of sparse patterns so that one model serves several sensors (lipjax.data.sampling.Mixture).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from lipjax.discriminator import Discriminator
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+from lipjax.train.config import DataConfig, TrainConfig
+
+INDOOR_MAX_DEPTH_M = 10.0
+OUTDOOR_MAX_DEPTH_M = 85.0
+
+INDOOR_DATA = DataConfig(
+    kind="indoor", height=256, width=320, crop=(128, 160),
+    train_sampler="uniform:200|uniform:100|uniform:500|uniform:1000|bernoulli:200",
+    val_sampler="uniform:200", val_images=32,
+)
+OUTDOOR_DATA = DataConfig(
+    kind="outdoor", height=128, width=416, crop=(128, 208),
+    train_sampler="lidar:hdl64|lidar:vlp32|lidar:vlp16|uniform:500|uniform:200",
+    val_sampler="lidar:hdl64", val_images=32,
+)
+
+
+def _model(max_depth_m: float, preset: str = "small", iterations: int = 3) -> LIPConfig:
+    return LIPConfig(prior=network_preset(preset, max_depth_m=max_depth_m), num_iterations=iterations)
+
+
+LIP_CNN_INDOOR = TrainConfig(
+    name="lip-cnn-indoor", model=_model(INDOOR_MAX_DEPTH_M), data=INDOOR_DATA,
+    batch_size=8, g_steps=1500, learning_rate=1e-3, eval_every=250, checkpoint_every=50,
+)
+LIP_CNN_OUTDOOR = dataclasses.replace(
+    LIP_CNN_INDOOR, name="lip-cnn-outdoor", model=_model(OUTDOOR_MAX_DEPTH_M), data=OUTDOOR_DATA,
+)
+# LIP+AD: start from the LIP+CNN model, pretrain D with G frozen, then train both (paper Sec. III-B).
+LIP_AD_INDOOR = dataclasses.replace(
+    LIP_CNN_INDOOR, name="lip-ad-indoor", init_from="lip-cnn-indoor", g_steps=0, d_steps=100, adv_steps=400,
+    learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3, discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M),
+)
+LIP_AD_OUTDOOR = dataclasses.replace(
+    LIP_AD_INDOOR, name="lip-ad-outdoor", model=_model(OUTDOOR_MAX_DEPTH_M), data=OUTDOOR_DATA,
+    init_from="lip-cnn-outdoor", discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M),
+)
+
+SMOKE = TrainConfig(
+    name="smoke", model=LIPConfig(prior=network_preset("tiny"), num_iterations=2),
+    data=DataConfig(kind="indoor", height=48, width=64, crop=(32, 48), val_images=4),
+    batch_size=2, g_steps=4, d_steps=2, adv_steps=2, log_every=2, eval_every=8, checkpoint_every=4,
+)
+
+CONFIGS: dict[str, TrainConfig] = {
+    "lip_cnn_indoor": LIP_CNN_INDOOR,
+    "lip_cnn_outdoor": LIP_CNN_OUTDOOR,
+    "lip_ad_indoor": LIP_AD_INDOOR,
+    "lip_ad_outdoor": LIP_AD_OUTDOOR,
+    "smoke": SMOKE,
+}
+
+
+def get_config(name: str, overrides: dict[str, str] | None = None) -> TrainConfig:
+    """A named config with `field=value` overrides of top-level scalar fields (e.g. {'g_steps': '200'})."""
+    if name not in CONFIGS:
+        raise ValueError(f"unknown config {name!r}; choose one of {sorted(CONFIGS)}")
+    config = CONFIGS[name]
+    changes = {}
+    for key, text in (overrides or {}).items():
+        fields = {f.name: f for f in dataclasses.fields(config)}
+        if key not in fields:
+            raise ValueError(f"unknown config field {key!r}; fields: {sorted(fields)}")
+        current = getattr(config, key)
+        changes[key] = None if text == "None" else type(current)(text) if current is not None else text
+    return dataclasses.replace(config, **changes)

@@ -1,0 +1,40 @@
+"""Hand-crafted depth completers, all behind the one `Completer` interface (lipjax.baselines.completer):
+
+    completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
+
+  NearestFill        nearest sample (Voronoi), exact at samples                  ignores RGB   nearest.py
+  LinearFill         Delaunay piecewise-linear, nearest outside the hull         ignores RGB   interpolate.py
+  IPBasicFill        IP-Basic morphological fill (Ku et al. 2018)                ignores RGB   ipbasic.py
+  ColorizationFill   Levin et al. 2004 colourisation (NYU toolbox), exact at     RGB-guided    colorization.py
+                     samples
+
+Each raises ValueError for an empty sparse map, mismatched shapes, NaN / inf or negative depth. The LIP+Wavelet
+baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
+"""
+from __future__ import annotations
+
+from lipjax.baselines.colorization import ColorizationFill, colorization_fill
+from lipjax.baselines.completer import BatchFnCompleter, Completer, check_inputs
+from lipjax.baselines.interpolate import LinearFill, linear_fill
+from lipjax.baselines.ipbasic import IPBasicFill, ipbasic_fill
+from lipjax.baselines.nearest import NearestFill, nearest_fill
+
+__all__ = [
+    "BatchFnCompleter",
+    "ColorizationFill",
+    "Completer",
+    "IPBasicFill",
+    "LinearFill",
+    "NearestFill",
+    "check_inputs",
+    "classical_completers",
+    "colorization_fill",
+    "ipbasic_fill",
+    "linear_fill",
+    "nearest_fill",
+]
+
+
+def classical_completers() -> list[Completer]:
+    """One instance of each classical completer with its default (density-adaptive) parameters."""
+    return [NearestFill(), LinearFill(), IPBasicFill(), ColorizationFill()]

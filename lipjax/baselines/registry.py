@@ -1,0 +1,22 @@
+"""Classical completers by name, for configs and command lines: `make_completer("ip_basic", radius_px=5)`."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from lipjax.baselines.classical import ColorizationFill, IPBasicFill, LinearFill, NearestFill
+from lipjax.baselines.completer import Completer
+
+COMPLETERS: dict[str, Callable[..., Completer]] = {
+    "nearest": NearestFill,
+    "linear": LinearFill,
+    "ip_basic": IPBasicFill,
+    "colorization": ColorizationFill,
+}
+
+
+def make_completer(name: str, **kwargs: Any) -> Completer:
+    """Builds the completer registered as `name`, with dataclass fields overridden by kwargs."""
+    if name not in COMPLETERS:
+        raise ValueError(f"unknown completer {name!r}; known: {sorted(COMPLETERS)}")
+    return COMPLETERS[name](**kwargs)

@@ -1,0 +1,191 @@
+"""Runs any depth completer over a data set and reports metrics (lipjax.metrics) and time per frame.
+
+    result = evaluate(NearestFill(), dataset, UniformSampler(200), min_depth_m=0.0, max_depth_m=10.0)
+    print(markdown_table({"nearest": result}))
+
+Protocol, in one place:
+  - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
+    sample id and this seed, so every method sees the same inputs and reruns are identical;
+  - metrics are per image over valid ground truth within [min_depth_m, max_depth_m], then averaged over images
+    (see lipjax.metrics);
+  - time per frame is the wall-clock time of the completer call alone (sampling and metrics excluded), including
+    the conversion of its output to numpy, which waits for asynchronous JAX computations to finish. The first
+    call on a new image shape of a jitted model compiles, so one untimed warm-up call on the first sample
+    precedes the timed pass (that frame is then run again, timed). Times depend on the machine and its load.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import os
+import statistics
+import sys
+import time
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from lipjax.baselines.completer import Completer
+from lipjax.data.sample import Sample
+from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
+
+Sampler = Callable[[Sample, int], np.ndarray]  # (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample
+
+DEFAULT_COLUMNS = (
+    "rmse_m",
+    "mae_m",
+    "rel",
+    "delta1_pct",
+    "delta2_pct",
+    "delta3_pct",
+    "irmse_1_per_km",
+    "imae_1_per_km",
+    "mae_sampled_m",
+    "mae_unsampled_m",
+    "mae_vs_input_m",
+    "ms_per_frame",
+)
+# Decimal places per column in tables; others get 3.
+_DECIMALS = {"rmse_mm": 1, "mae_mm": 1, "delta1_pct": 2, "delta2_pct": 2, "delta3_pct": 2, "ms_per_frame": 1,
+             "irmse_1_per_km": 2, "imae_1_per_km": 2}
+
+
+@dataclasses.dataclass
+class EvalResult:
+    """Metrics of one completer over one data set.
+
+    Attributes:
+      name: the completer's name.
+      metrics: data-set metrics, each the mean over images of the per-image values (lipjax.metrics names).
+      counts: number of images behind each mean; summed pixel counts under the "n_" keys.
+      per_image: one dict per frame: "id", the per-image metrics and "ms" (completion time, milliseconds).
+      ms_per_frame: mean completion time per frame in milliseconds (warm-up call excluded).
+      ms_per_frame_median: median of the same.
+      num_images: frames evaluated.
+      min_depth_m, max_depth_m: the evaluated ground-truth depth range, metres.
+    """
+
+    name: str
+    metrics: dict[str, float]
+    counts: dict[str, int]
+    per_image: list[dict[str, Any]]
+    ms_per_frame: float
+    ms_per_frame_median: float
+    num_images: int
+    min_depth_m: float
+    max_depth_m: float
+
+    def row(self) -> dict[str, float]:
+        """The metrics plus "ms_per_frame", as one table row."""
+        return {**self.metrics, "ms_per_frame": self.ms_per_frame}
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+def evaluate(
+    completer: Completer,
+    dataset: Sequence[Sample],
+    sampler: Sampler,
+    *,
+    min_depth_m: float,
+    max_depth_m: float,
+    limit: int | None = None,
+    progress: bool = True,
+    seed: int = 0,
+    warmup: bool = True,
+    pred_floor_m: float = DEFAULT_PRED_FLOOR_M,
+) -> EvalResult:
+    """Completes every sample of `dataset` (the first `limit` ones if given) and scores it.
+
+    Args:
+      completer: (rgb (H, W, 3) uint8, sparse (H, W) float32 m) -> (H, W) metres, with a `name`.
+      dataset: an indexable of `Sample` with len().
+      sampler: (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample.
+      min_depth_m, max_depth_m: evaluated ground-truth range (min, max] in metres; a named protocol of
+        lipjax.data.protocols carries them (protocol.min_depth_m, protocol.max_depth_m).
+      limit: evaluate only the first `limit` samples.
+      progress: show a progress bar on stderr.
+      seed: passed to the sampler with every sample.
+      warmup: make one untimed call on the first sample first (compilation of jitted models).
+      pred_floor_m: see lipjax.metrics.compute_metrics.
+
+    Returns:
+      EvalResult. Raises ValueError if the data set is empty or a prediction has the wrong shape.
+    """
+    n = len(dataset) if limit is None else min(limit, len(dataset))
+    if n <= 0:
+        raise ValueError("nothing to evaluate: the data set is empty (or limit <= 0)")
+    name = getattr(completer, "name", type(completer).__name__)
+    agg = MetricAggregator()
+    per_image: list[dict[str, Any]] = []
+    times_ms: list[float] = []
+    indices = range(n)
+    if progress:
+        from tqdm import tqdm
+
+        indices = tqdm(indices, desc=name, file=sys.stderr, leave=False)
+    for i in indices:
+        sample = dataset[i]
+        sparse = np.asarray(sampler(sample, seed), dtype=np.float32)
+        if warmup and i == 0:
+            np.asarray(completer(sample.rgb, sparse))
+        t0 = time.perf_counter()
+        pred = np.asarray(completer(sample.rgb, sparse))
+        dt_ms = 1000.0 * (time.perf_counter() - t0)
+        if pred.shape != sample.depth.shape:
+            raise ValueError(f"{name}: prediction shape {pred.shape} != ground truth {sample.depth.shape} ({sample.id})")
+        m = compute_metrics(
+            pred, sample.depth, sample.valid, sparse,
+            min_depth_m=min_depth_m, max_depth_m=max_depth_m, pred_floor_m=pred_floor_m,
+        )
+        agg.add(m)
+        per_image.append({"id": sample.id, **m, "ms": dt_ms})
+        times_ms.append(dt_ms)
+    return EvalResult(
+        name=name,
+        metrics=agg.means(),
+        counts=agg.counts(),
+        per_image=per_image,
+        ms_per_frame=float(np.mean(times_ms)),
+        ms_per_frame_median=float(statistics.median(times_ms)),
+        num_images=n,
+        min_depth_m=float(min_depth_m),
+        max_depth_m=float(max_depth_m),
+    )
+
+
+def _fmt(column: str, value: float | None) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    return f"{value:.{_DECIMALS.get(column, 3)}f}"
+
+
+def markdown_table(results: Mapping[str, EvalResult], columns: Sequence[str] = DEFAULT_COLUMNS) -> str:
+    """A Markdown table: one row per method (the mapping's keys), one column per metric (names carry units).
+
+    Missing or NaN values print as "n/a". "ms_per_frame" is the mean completion time in milliseconds.
+    """
+    lines = ["| method | " + " | ".join(columns) + " |", "|---|" + "---:|" * len(columns)]
+    for method, res in results.items():
+        row = res.row()
+        lines.append(f"| {method} | " + " | ".join(_fmt(c, row.get(c)) for c in columns) + " |")
+    return "\n".join(lines)
+
+
+def save_json(results: Mapping[str, EvalResult], path: str | os.PathLike) -> None:
+    """Writes {method: EvalResult.to_dict()} as JSON (NaN written as null)."""
+
+    def clean(x):
+        if isinstance(x, float) and not math.isfinite(x):
+            return None
+        if isinstance(x, dict):
+            return {k: clean(v) for k, v in x.items()}
+        if isinstance(x, list):
+            return [clean(v) for v in x]
+        return x
+
+    with open(path, "w") as f:
+        json.dump({k: clean(v.to_dict()) for k, v in results.items()}, f, indent=1)

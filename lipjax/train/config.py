@@ -1,0 +1,76 @@
+"""Training configuration as typed, frozen dataclasses (configs are code: see experiments/configs.py).
+
+A run has up to three phases, by global step:
+    [0, g_steps)                      G supervised pretraining (L2 through the whole unrolled solver)
+    [g_steps, g_steps + d_steps)      D pretraining (cross-entropy, G frozen)
+    [.., .. + adv_steps)              joint G + D adversarial training (LIP+AD)
+LIP+CNN is g_steps only; LIP+AD adds the other two (usually starting from a LIP+CNN model via `init_from`).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from lipjax.discriminator import Discriminator
+from lipjax.model import LIPConfig
+
+
+@dataclasses.dataclass(frozen=True)
+class DataConfig:
+    """The embedded synthetic data: scene kind, render size, training crop and the sparse samplers.
+
+    Training batches are random crops of full-size renders, so that at test time (full size) the network sees
+    objects at the same pixel scale and the samples at the same density as in training.
+    """
+
+    kind: str = "indoor"
+    height: int = 256
+    width: int = 320
+    crop: tuple[int, int] | None = (128, 160)
+    train_sampler: str = "uniform:200"
+    val_sampler: str = "uniform:200"
+    val_images: int = 32
+    num_workers: int = 1
+
+
+@dataclasses.dataclass(frozen=True)
+class TrainConfig:
+    """Everything that defines a training run. Step counts are global optimisation steps."""
+
+    name: str
+    model: LIPConfig
+    data: DataConfig = DataConfig()
+    discriminator: Discriminator = Discriminator()
+    batch_size: int = 8
+    g_steps: int = 1000
+    d_steps: int = 0
+    adv_steps: int = 0
+    learning_rate: float = 1e-3
+    d_learning_rate: float = 2e-4
+    warmup_steps: int = 100
+    weight_decay: float = 1e-4
+    grad_clip_norm: float = 1.0
+    loss: str = "l2"
+    iteration_weights: tuple[float, ...] = ()
+    adv_weight: float = 1e-3
+    log_every: int = 10
+    eval_every: int = 500
+    checkpoint_every: int = 100
+    keep_checkpoints: int = 3
+    seed: int = 0
+    init_from: str | None = None
+
+    @property
+    def total_steps(self) -> int:
+        return self.g_steps + self.d_steps + self.adv_steps
+
+    def phase(self, step: int) -> str:
+        """'supervised', 'discriminator' or 'adversarial' for a global step."""
+        if step < self.g_steps:
+            return "supervised"
+        if step < self.g_steps + self.d_steps:
+            return "discriminator"
+        return "adversarial"
+
+    @property
+    def adversarial(self) -> bool:
+        return self.d_steps + self.adv_steps > 0

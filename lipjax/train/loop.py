@@ -1,0 +1,199 @@
+"""The training loop: resumable, data-parallel, logged, with periodic validation and NaN detection.
+
+    train(config, workdir)   # resumes from workdir/checkpoints if present
+
+Layout of `workdir`: checkpoints/<step>/ (orbax), metrics.jsonl (one JSON object per logged step or evaluation),
+config.txt (the config's repr). Resume is exact: the state holds parameters, both optimiser states, the step
+and the RNG key; the data position is the step (batch s is a pure function of (seed, s), see
+lipjax.data.pipeline), recorded in each checkpoint's metadata and checked on resume.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import pathlib
+import time
+from typing import Any
+
+import jax
+import numpy as np
+from jax.sharding import NamedSharding, PartitionSpec
+from tqdm.auto import tqdm
+
+from lipjax import model as lip_model
+from lipjax import model_io
+from lipjax.checkpoint import CheckpointManager
+from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_batch
+from lipjax.data.sample import Batch
+from lipjax.data.sampling import example_rng, sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.metrics import MetricAggregator, compute_metrics
+from lipjax.train.config import TrainConfig
+from lipjax.train.state import TrainState, init_state  # noqa: F401  (re-exported)
+from lipjax.train.steps import make_steps
+
+EVAL_BATCH_SIZE = 4
+
+
+class TrainingDiverged(RuntimeError):
+    """A non-finite loss: training stops and the last good checkpoint is kept."""
+
+
+def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int) -> Batch:
+    """Crops every example of a batch at a position drawn from (seed, step, example): resumable and deterministic."""
+    if crop is None:
+        return batch
+    ch, cw = crop
+    _, h, w = batch.gt.shape
+    if (ch, cw) == (h, w):
+        return batch
+    if ch > h or cw > w:
+        raise ValueError(f"crop {crop} is larger than the {h}x{w} images")
+    rng = example_rng(seed, f"crop/{step}")
+    tops = rng.integers(0, h - ch + 1, len(batch.gt))
+    lefts = rng.integers(0, w - cw + 1, len(batch.gt))
+
+    def cut(a):
+        return np.stack([x[t : t + ch, l : l + cw] for x, t, l in zip(a, tops, lefts)])
+
+    return Batch(rgb=cut(batch.rgb), sparse=cut(batch.sparse), gt=cut(batch.gt), gt_valid=cut(batch.gt_valid))
+
+
+def validation_batches(config: TrainConfig) -> list[Batch]:
+    """The fixed validation set: the first `val_images` synthetic val frames at full size, with val_sampler."""
+    d = config.data
+    dataset = SyntheticDataset(d.kind, "val", size=d.val_images, height=d.height, width=d.width)
+    it = BatchIterator(dataset, min(EVAL_BATCH_SIZE, len(dataset)), sampler_from_spec(d.val_sampler), shuffle=False,
+                       drop_last=False, num_epochs=1)
+    return list(it)
+
+
+def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: float) -> dict[str, float]:
+    """Per-image-then-mean metrics of a LIP model over batches (lipjax.metrics)."""
+    apply = _jitted_apply(model_config)
+    agg = MetricAggregator()
+    for b in batches:
+        pred = np.asarray(apply(params, b.rgb, b.sparse))
+        for i in range(len(pred)):
+            agg.add(compute_metrics(pred[i], b.gt[i], b.gt_valid[i], b.sparse[i], min_depth_m=0.0, max_depth_m=max_depth_m))
+    return agg.means()
+
+
+_APPLY_CACHE: dict = {}
+
+
+def _jitted_apply(model_config):
+    if model_config not in _APPLY_CACHE:
+        _APPLY_CACHE[model_config] = jax.jit(lambda p, rgb, sparse: lip_model.apply(model_config, p, rgb, sparse)[0])
+    return _APPLY_CACHE[model_config]
+
+
+def _to_float(metrics: dict) -> dict:
+    return {k: float(v) for k, v in metrics.items()}
+
+
+def _initial_g_params(config: TrainConfig):
+    if config.init_from is None:
+        return None
+    init_config, params, _ = model_io.load(config.init_from)
+    if init_config != config.model:
+        raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, but this run needs {config.model}")
+    return params
+
+
+def train(
+    config: TrainConfig,
+    workdir: str | os.PathLike,
+    *,
+    stop_at: int | None = None,
+    progress: bool = True,
+    mesh=None,
+    process_index: int | None = None,
+    process_count: int | None = None,
+) -> TrainState:
+    """Trains (or resumes) a run in `workdir` until config.total_steps (or `stop_at`, to split a run in parts).
+
+    Data-parallel over all devices of `mesh` (default: every device): batches are sharded over the 'data' axis
+    and the state is replicated. Multi-host: call jax.distributed.initialize() first in every process; each
+    process loads its own slice of every global batch.
+    """
+    workdir = pathlib.Path(workdir)
+    workdir.mkdir(parents=True, exist_ok=True)
+    (workdir / "config.txt").write_text(repr(config) + "\n")
+    mesh = make_data_mesh() if mesh is None else mesh
+    replicated = NamedSharding(mesh, PartitionSpec())
+    process_index = jax.process_index() if process_index is None else process_index
+    process_count = jax.process_count() if process_count is None else process_count
+    is_main = process_index == 0
+
+    manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
+    state = init_state(config, _initial_g_params(config))
+    if manager.latest_step() is not None:
+        state, meta = manager.restore(state)
+        if meta.get("data_position") != int(state.step):
+            raise RuntimeError(f"checkpoint data position {meta.get('data_position')} != step {int(state.step)}")
+        if is_main:
+            print(f"[lipjax] resumed {config.name} from step {int(state.step)} in {manager.directory}")
+    state = jax.device_put(state, replicated)
+    steps = make_steps(config)
+    val = validation_batches(config) if config.eval_every else []
+    max_depth = float(getattr(config.model.prior, "max_depth_m", 10.0))
+
+    end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
+    start = int(state.step)
+    d = config.data
+    train_set = SyntheticDataset(d.kind, "train", height=d.height, width=d.width)
+    batches = BatchIterator(train_set, config.batch_size, sampler_from_spec(d.train_sampler), seed=config.seed,
+                            start_step=start, process_index=process_index, process_count=process_count,
+                            num_workers=d.num_workers)
+    log = open(workdir / "metrics.jsonl", "a") if is_main else None
+    bar = tqdm(total=end, initial=start, desc=config.name, disable=not (progress and is_main), dynamic_ncols=True)
+    rng = jax.random.wrap_key_data(np.asarray(state.rng))
+    t_last, images = time.perf_counter(), 0
+    step = start
+    try:
+        with prefetch(iter(batches), 2) as stream:
+            for step in range(start, end):
+                batch = random_crop(next(stream), d.crop, config.seed, step)
+                phase = config.phase(step)
+                state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
+                images += config.batch_size
+                done = step + 1
+                if done % config.log_every == 0 or done == end:
+                    metrics = _to_float(metrics)
+                    if not math.isfinite(metrics["loss"]):
+                        raise TrainingDiverged(
+                            f"non-finite loss {metrics['loss']} at step {done} ({phase}); stopped without saving. "
+                            f"The last good checkpoint is step {manager.latest_step()} in {manager.directory}; "
+                            f"lower the learning rate or check the data."
+                        )
+                    now = time.perf_counter()
+                    rate = images / (now - t_last)
+                    t_last, images = now, 0
+                    bar.set_postfix(loss=f"{metrics['loss']:.4g}", img_s=f"{rate:.1f}", phase=phase[:3])
+                    if log:
+                        log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
+                        log.flush()
+                if done % config.checkpoint_every == 0 or done == end:
+                    manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name})
+                if val and (done % config.eval_every == 0 or done == end) and is_main:
+                    vm = evaluate_params(config.model, state.g_params, val, max_depth)
+                    log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
+                    log.flush()
+                    bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
+                bar.update(1)
+    finally:
+        bar.close()
+        batches.close()
+        if log:
+            log.close()
+        manager.close()
+    return state
+
+
+def export(config: TrainConfig, state: TrainState, path: str | os.PathLike, metadata: dict[str, Any] | None = None) -> None:
+    """Saves the trained G as a loadable model (lipjax.load_model(path))."""
+    params = jax.tree_util.tree_map(np.asarray, state.g_params)
+    meta = {"train_config": config.name, "steps": int(state.step), **(metadata or {})}
+    model_io.save(path, config.model, params, meta)

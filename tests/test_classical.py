@@ -1,0 +1,231 @@
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+from scipy import interpolate
+
+from lipjax.baselines.classical import (
+    BatchFnCompleter,
+    ColorizationFill,
+    Completer,
+    IPBasicFill,
+    LinearFill,
+    NearestFill,
+    classical_completers,
+    nearest_fill,
+)
+from lipjax.baselines.colorization import luma, neighbour_weights, nested_dissection_order, _OFFSETS
+from lipjax.baselines.ipbasic import auto_radius_px, diamond_kernel
+from lipjax.baselines.registry import COMPLETERS, make_completer
+
+
+def _random_sparse(h, w, n, seed=0, lo=1.0, hi=5.0):
+    rng = np.random.default_rng(seed)
+    s = np.zeros((h, w), np.float32)
+    s.flat[rng.choice(h * w, n, replace=False)] = rng.uniform(lo, hi, n)
+    return s
+
+
+def _gray(h, w, value=128):
+    return np.full((h, w, 3), value, np.uint8)
+
+
+# ---------------------------------------------------------------- interface and input checks
+
+
+@pytest.mark.parametrize("completer", classical_completers(), ids=lambda c: c.name)
+def test_output_contract(completer):
+    s = _random_sparse(24, 30, 20)
+    out = completer(_gray(24, 30), s)
+    assert isinstance(completer, Completer)
+    assert out.shape == (24, 30) and out.dtype == np.float32
+    assert np.all(np.isfinite(out))
+    # no method may leave the range of its samples by much (all are interpolators or local averages)
+    assert s[s > 0].min() - 1e-4 <= out.min() and out.max() <= s.max() + 1e-4
+
+
+@pytest.mark.parametrize("completer", classical_completers(), ids=lambda c: c.name)
+def test_invalid_inputs_raise_value_error(completer):
+    rgb, s = _gray(8, 9), _random_sparse(8, 9, 5)
+    with pytest.raises(ValueError, match="empty"):
+        completer(rgb, np.zeros_like(s))
+    with pytest.raises(ValueError, match="mismatch"):
+        completer(_gray(8, 10), s)
+    bad = s.copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        completer(rgb, bad)
+    bad[0, 0] = -1.0
+    with pytest.raises(ValueError, match="negative"):
+        completer(rgb, bad)
+    with pytest.raises(ValueError, match="uint8"):
+        completer(rgb.astype(np.float32), s)
+    with pytest.raises(ValueError):
+        completer(rgb, s[None])
+
+
+def test_registry():
+    assert set(COMPLETERS) == {c.name for c in classical_completers()}
+    assert make_completer("ip_basic", radius_px=3).radius_px == 3
+    with pytest.raises(ValueError, match="unknown"):
+        make_completer("bicubic")
+
+
+def test_batch_fn_completer_wraps_a_jitted_batch_function():
+    calls = []
+
+    @jax.jit
+    def fn(rgb, sparse):
+        calls.append(rgb.shape)  # traced once per shape
+        return sparse + rgb[..., 0]  # rgb arrives as float in [0, 1]
+
+    c = BatchFnCompleter("toy", fn)
+    s = _random_sparse(6, 7, 4)
+    rgb = _gray(6, 7, 255)
+    np.testing.assert_allclose(c(rgb, s), s + 1.0, rtol=1e-6)
+    c(rgb, s)
+    assert calls == [(1, 6, 7, 3)]
+    with pytest.raises(ValueError, match="shape"):
+        BatchFnCompleter("bad", lambda r, d: jnp.zeros((1, 3, 3)))(rgb, s)
+
+
+# ---------------------------------------------------------------- nearest
+
+
+def test_nearest_exact_at_samples_and_takes_nearest_sample():
+    s = np.zeros((5, 5), np.float32)
+    s[0, 0], s[4, 4] = 1.0, 3.0
+    out = NearestFill()(_gray(5, 5), s)
+    assert out[0, 0] == 1.0 and out[4, 4] == 3.0
+    assert out[1, 1] == 1.0 and out[0, 3] == 1.0  # closer to (0, 0)
+    assert out[3, 4] == 3.0 and out[2, 4] == 3.0  # (2, 4): distance 2 to (4, 4) vs sqrt(20) to (0, 0)
+    s = _random_sparse(20, 25, 30)
+    out = NearestFill()(_gray(20, 25), s)
+    np.testing.assert_array_equal(out[s > 0], s[s > 0])
+    assert set(np.unique(out)) <= set(np.unique(s[s > 0]))  # every value is a sample value
+
+
+# ---------------------------------------------------------------- linear
+
+
+def test_linear_exact_on_a_plane_inside_hull_and_nearest_outside():
+    h, w = 30, 40
+    yy, xx = np.mgrid[0:h, 0:w]
+    plane = (2.0 + 0.05 * xx + 0.03 * yy).astype(np.float32)
+    s = np.zeros((h, w), np.float32)
+    pts = [(3, 4), (3, 35), (26, 5), (25, 36), (15, 20), (10, 28)]
+    for p in pts:
+        s[p] = plane[p]
+    out = LinearFill()(_gray(h, w), s)
+    # inside the quadrilateral hull of the four corner samples: exact plane
+    inside = (yy >= 4) & (yy <= 24) & (xx >= 6) & (xx <= 34)
+    np.testing.assert_allclose(out[inside], plane[inside], atol=1e-5)
+    np.testing.assert_allclose(out[s > 0], s[s > 0], atol=1e-6)
+    corner = nearest_fill(s)
+    assert out[0, 0] == corner[0, 0] == s[3, 4]  # outside the hull: nearest sample
+
+
+def test_linear_matches_scipy_linearndinterpolator():
+    s = _random_sparse(23, 31, 40, seed=3)
+    out = LinearFill()(_gray(23, 31), s)
+    ys, xs = np.nonzero(s)
+    ref = interpolate.LinearNDInterpolator(np.stack([ys, xs], 1).astype(float), s[ys, xs].astype(float))(
+        *np.mgrid[0:23, 0:31]
+    )
+    inside = ~np.isnan(ref)
+    np.testing.assert_allclose(out[inside], ref[inside], atol=1e-5)
+    np.testing.assert_array_equal(out[~inside], nearest_fill(s)[~inside])
+
+
+def test_linear_degenerate_samples_fall_back_to_nearest():
+    s = np.zeros((9, 9), np.float32)
+    s[4, 1], s[4, 5], s[4, 8] = 1.0, 2.0, 3.0  # one scan line: collinear
+    np.testing.assert_array_equal(LinearFill()(_gray(9, 9), s), nearest_fill(s))
+    s2 = np.zeros((9, 9), np.float32)
+    s2[1, 1], s2[7, 7] = 1.0, 2.0  # two points
+    np.testing.assert_array_equal(LinearFill()(_gray(9, 9), s2), nearest_fill(s2))
+
+
+# ---------------------------------------------------------------- IP-Basic
+
+
+def test_ipbasic_keeps_a_dense_smooth_map():
+    h, w = 32, 40
+    yy, xx = np.mgrid[0:h, 0:w]
+    dense = (3.0 + 0.02 * xx + 0.05 * yy).astype(np.float32)
+    out = IPBasicFill()(_gray(h, w), dense)
+    # closing and the median keep a ramp; dilation of inverted depth shifts it by at most one kernel step
+    interior = (slice(3, -3), slice(3, -3))
+    assert np.abs(out - dense)[interior].max() < 0.2
+    const = IPBasicFill()(_gray(h, w), np.full((h, w), 4.0, np.float32))
+    np.testing.assert_allclose(const, 4.0, atol=1e-4)
+
+
+def test_ipbasic_fills_everything_from_few_samples_and_prefers_near_surfaces():
+    s = _random_sparse(40, 50, 6, seed=1)
+    out = IPBasicFill()(_gray(40, 50), s)
+    assert np.all(out > 0) and np.all(np.isfinite(out))
+    # Pixel (10, 9) is 5 px from a near sample (1 m) and 3 px from a far one (9 m); both diamonds (r = 6)
+    # reach it. The max-dilation of inverted depth lets the nearer surface win (IP-Basic's reason for
+    # inverting), where a nearest fill takes the far one.
+    s = np.zeros((21, 21), np.float32)
+    s[10, 4], s[10, 12] = 1.0, 9.0
+    out = IPBasicFill(radius_px=6, blur="none")(_gray(21, 21), s)
+    assert out[10, 9] == pytest.approx(1.0, abs=1e-4)
+    assert nearest_fill(s)[10, 9] == 9.0
+
+
+def test_ipbasic_radius_adapts_to_density():
+    dense = np.zeros((64, 64), np.float32)
+    dense[::4, ::4] = 5.0  # a sample every 4 px: gaps of <= 2.8 px
+    sparse = np.zeros((64, 64), np.float32)
+    sparse[::16, ::16] = 5.0
+    r_dense, r_sparse = auto_radius_px(dense), auto_radius_px(sparse)
+    assert r_dense == 3 and r_sparse > 2 * r_dense
+    np.testing.assert_array_equal(diamond_kernel(1), [[0, 1, 0], [1, 1, 1], [0, 1, 0]])
+
+
+# ---------------------------------------------------------------- colourisation
+
+
+def test_colorization_reproduces_constant_and_keeps_samples_exactly():
+    rng = np.random.default_rng(2)
+    rgb = rng.integers(0, 256, (20, 24, 3)).astype(np.uint8)
+    s = np.zeros((20, 24), np.float32)
+    s[rng.random((20, 24)) < 0.05] = 2.5
+    np.testing.assert_allclose(ColorizationFill()(rgb, s), 2.5, rtol=1e-5)
+    s = _random_sparse(20, 24, 15, seed=4)
+    out = ColorizationFill()(rgb, s)
+    np.testing.assert_array_equal(out[s > 0], s[s > 0])
+
+
+def test_colorization_solves_the_levin_equations():
+    rng = np.random.default_rng(5)
+    rgb = rng.integers(0, 256, (12, 14, 3)).astype(np.uint8)
+    s = _random_sparse(12, 14, 10, seed=6)
+    x = ColorizationFill()(rgb, s).astype(np.float64)
+    wts = neighbour_weights(luma(rgb))
+    wts /= wts.sum(0)
+    xp = np.pad(x, 1)
+    avg = sum(wts[k] * xp[1 + dy : 13 + dy, 1 + dx : 15 + dx] for k, (dy, dx) in enumerate(_OFFSETS))
+    unknown = s == 0
+    np.testing.assert_allclose(x[unknown], avg[unknown], atol=1e-5)  # x_r = sum_s wbar_rs x_s
+
+
+def test_colorization_follows_image_edges():
+    # Left half dark, right half bright (edge between columns 15 and 16); one sample on each side.
+    h, w = 16, 32
+    rgb = np.zeros((h, w, 3), np.uint8)
+    rgb[:, 16:] = 255
+    s = np.zeros((h, w), np.float32)
+    s[8, 2], s[8, 22] = 1.0, 5.0
+    out = ColorizationFill()(rgb, s)
+    assert np.all(np.abs(out[:, :16] - 1.0) < 0.05)
+    assert np.all(np.abs(out[:, 16:] - 5.0) < 0.05)
+    # an image-blind fill puts its boundary half-way between the samples (column 12), not at the image edge
+    np.testing.assert_array_equal(nearest_fill(s)[:, 13:16], 5.0)
+
+
+def test_nested_dissection_order_is_a_permutation():
+    for h, w in [(1, 1), (3, 7), (17, 9), (64, 80)]:
+        np.testing.assert_array_equal(np.sort(nested_dissection_order(h, w)), np.arange(h * w))

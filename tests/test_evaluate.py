@@ -1,0 +1,110 @@
+import json
+import math
+
+import jax
+import numpy as np
+import pytest
+
+from lipjax.baselines.classical import BatchFnCompleter, NearestFill
+from lipjax.data.sample import Intrinsics, Sample
+from lipjax.evaluate import EvalResult, evaluate, markdown_table, save_json
+from lipjax.metrics import compute_metrics
+
+H, W = 12, 16
+
+
+def _dataset(n=3):
+    yy, xx = np.mgrid[0:H, 0:W]
+    out = []
+    for i in range(n):
+        depth = (1.0 + i + 0.1 * xx + 0.05 * yy).astype(np.float32)
+        depth[0, :3] = 0  # a few invalid pixels
+        rgb = np.full((H, W, 3), 40 * i, np.uint8)
+        out.append(Sample.from_depth(rgb, depth, Intrinsics(10.0, 10.0, W / 2, H / 2), f"toy/{i}"))
+    return out
+
+
+def _sampler(sample: Sample, seed: int) -> np.ndarray:
+    """Exactly 6 valid pixels, drawn from a key derived from the sample id and the seed."""
+    rng = np.random.default_rng([seed, int(sample.id.split("/")[1])])
+    idx = rng.choice(np.flatnonzero(sample.valid), 6, replace=False)
+    sparse = np.zeros(sample.shape, np.float32)
+    sparse.flat[idx] = sample.depth.flat[idx]
+    return sparse
+
+
+class _Counting:
+    name = "counting_nearest"
+
+    def __init__(self):
+        self.calls = 0
+
+    def __call__(self, rgb, sparse):
+        self.calls += 1
+        return NearestFill()(rgb, sparse)
+
+
+def test_evaluate_aggregates_per_image_metrics():
+    data = _dataset()
+    res = evaluate(NearestFill(), data, _sampler, min_depth_m=0.0, max_depth_m=2.5, progress=False)
+    assert res.name == "nearest" and res.num_images == 3 and len(res.per_image) == 3
+    assert [p["id"] for p in res.per_image] == ["toy/0", "toy/1", "toy/2"]
+    expected = []
+    for s in data:
+        sparse = _sampler(s, 0)
+        expected.append(compute_metrics(NearestFill()(s.rgb, sparse), s.depth, s.valid, sparse, min_depth_m=0.0, max_depth_m=2.5))
+    for k in ("mae_m", "rmse_m", "delta1_pct", "mae_unsampled_m"):
+        vals = [e[k] for e in expected if not math.isnan(e[k])]
+        assert res.metrics[k] == pytest.approx(np.mean(vals))
+        assert res.counts[k] == len(vals)
+    # depth range: image 2 starts at 3 m, above max_depth_m, so it has no evaluated pixel and is left out
+    assert res.counts["mae_m"] == 2 and res.per_image[2]["n_eval_px"] == 0
+    assert res.metrics["mae_vs_input_m"] == 0.0  # nearest fill is exact at the samples
+    assert res.ms_per_frame >= 0 and res.ms_per_frame_median >= 0 and all(p["ms"] >= 0 for p in res.per_image)
+
+
+def test_warmup_call_is_extra_and_limit_and_seed_are_honoured():
+    c = _Counting()
+    res = evaluate(c, _dataset(), _sampler, min_depth_m=0.0, max_depth_m=100.0, limit=2, progress=False)
+    assert res.num_images == 2 and c.calls == 3  # one untimed warm-up + two timed
+    c2 = _Counting()
+    evaluate(c2, _dataset(), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False, warmup=False)
+    assert c2.calls == 3
+    seeds = []
+    evaluate(NearestFill(), _dataset(2), lambda s, seed: seeds.append(seed) or _sampler(s, seed), min_depth_m=0.0,
+             max_depth_m=100.0, seed=7, progress=False)
+    assert seeds == [7, 7]
+    a = evaluate(NearestFill(), _dataset(), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+    b = evaluate(NearestFill(), _dataset(), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+    assert a.metrics == b.metrics  # deterministic inputs, deterministic method
+
+
+def test_evaluate_rejects_wrong_shapes_and_empty_datasets():
+    with pytest.raises(ValueError, match="shape"):
+        evaluate(lambda rgb, s: s[:-1], _dataset(1), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+    with pytest.raises(ValueError, match="empty"):
+        evaluate(NearestFill(), [], _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+
+
+def test_jitted_batch_model_as_completer():
+    model = BatchFnCompleter("jit_identity", jax.jit(lambda rgb, sparse: sparse))
+    res = evaluate(model, _dataset(2), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+    assert res.name == "jit_identity"
+    assert res.metrics["mae_vs_input_m"] == 0.0 and res.metrics["mae_sampled_m"] == 0.0
+
+
+def test_markdown_table_and_json(tmp_path):
+    res = evaluate(NearestFill(), _dataset(2), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
+    nan_res = EvalResult("x", {"rmse_m": math.nan}, {}, [], 1.25, 1.25, 0, 0.0, 1.0)
+    table = markdown_table({"nearest": res, "broken": nan_res}, columns=("rmse_m", "delta1_pct", "ms_per_frame"))
+    lines = table.splitlines()
+    assert lines[0] == "| method | rmse_m | delta1_pct | ms_per_frame |"
+    assert lines[1] == "|---|---:|---:|---:|"
+    assert lines[2].startswith("| nearest | ") and f"{res.metrics['rmse_m']:.3f}" in lines[2]
+    assert lines[3] == "| broken | n/a | n/a | 1.2 |"
+    path = tmp_path / "r.json"
+    save_json({"nearest": res, "broken": nan_res}, path)
+    loaded = json.loads(path.read_text())
+    assert loaded["nearest"]["metrics"]["mae_m"] == pytest.approx(res.metrics["mae_m"])
+    assert loaded["broken"]["metrics"]["rmse_m"] is None
+    assert len(loaded["nearest"]["per_image"]) == 2

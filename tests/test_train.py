@@ -1,0 +1,137 @@
+"""Training: a smoke run end to end, exact resume, NaN detection, and data-parallel equivalence on 4 devices."""
+import dataclasses
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import jax
+import numpy as np
+import pytest
+
+import lipjax
+from lipjax.data.sample import Batch
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+from lipjax.train import loop
+from lipjax.checkpoint import CheckpointManager
+from lipjax.train.config import DataConfig, TrainConfig
+from lipjax.train.state import init_state
+
+# One tiny config shared by the tests in this file, so that the jitted steps compile once (make_steps is cached).
+CONFIG = TrainConfig(
+    name="test",
+    model=LIPConfig(prior=network_preset("tiny"), num_iterations=1),  # K=1: tests are compile-bound
+    data=DataConfig(kind="indoor", height=32, width=40, crop=(24, 32), train_sampler="uniform:40",
+                    val_sampler="uniform:40", val_images=2, num_workers=0),
+    batch_size=2, g_steps=4, d_steps=2, adv_steps=2, log_every=1, eval_every=8, checkpoint_every=2,
+)
+
+
+def _leaves_equal(a, b):
+    return all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
+
+
+@pytest.fixture(scope="module")
+def straight_run(tmp_path_factory):
+    workdir = tmp_path_factory.mktemp("straight")
+    return workdir, loop.train(CONFIG, workdir, progress=False)
+
+
+def test_smoke_run_goes_through_all_phases_logs_and_exports(straight_run, tmp_path):
+    workdir, state = straight_run
+    assert int(state.step) == CONFIG.total_steps
+    rows = [json.loads(line) for line in (workdir / "metrics.jsonl").read_text().splitlines()]
+    phases = [r["phase"] for r in rows if "phase" in r]
+    assert phases == ["supervised"] * 4 + ["discriminator"] * 2 + ["adversarial"] * 2
+    assert all(np.isfinite(r["loss"]) for r in rows if "phase" in r)
+    assert "d_accuracy" in rows[-2] and "g_adversarial_loss" in rows[-2]
+    val = [r for r in rows if r.get("split") == "val"]
+    assert len(val) == 1 and val[0]["rmse_m"] > 0
+    loop.export(CONFIG, state, tmp_path / "model")
+    model = lipjax.load_model(tmp_path / "model")
+    rgb = np.zeros((24, 32, 3), np.uint8)
+    sparse = np.zeros((24, 32), np.float32)
+    sparse[5, 5] = 2.0
+    assert model(rgb, sparse).shape == (24, 32)
+
+
+def test_discriminator_phase_keeps_generator_frozen(straight_run):
+    workdir, _ = straight_run
+    manager = CheckpointManager(workdir / "checkpoints")
+    template = init_state(CONFIG)
+    # steps 4 -> 6 are the D-pretraining phase; 6 -> 8 adversarial (checkpoint_every=2, keep 3)
+    at = {step: manager.restore(template, step)[0] for step in (4, 6, 8)}
+    assert _leaves_equal(at[4].g_params, at[6].g_params)
+    assert not _leaves_equal(at[4].d_params, at[6].d_params)
+    assert not _leaves_equal(at[6].g_params, at[8].g_params)
+
+
+def test_interrupted_run_resumes_exactly(straight_run, tmp_path):
+    _, straight = straight_run
+    half = CONFIG.total_steps // 2
+    loop.train(CONFIG, tmp_path, stop_at=half, progress=False)  # the "killed" run: stopped after a checkpoint
+    resumed = loop.train(CONFIG, tmp_path, progress=False)
+    assert int(resumed.step) == CONFIG.total_steps
+    assert _leaves_equal(straight.g_params, resumed.g_params)
+    assert _leaves_equal(straight.d_params, resumed.d_params)
+    assert _leaves_equal(straight.g_opt_state, resumed.g_opt_state)
+
+
+def test_non_finite_loss_stops_and_keeps_last_good_checkpoint(tmp_path, monkeypatch):
+    real_crop = loop.random_crop
+
+    def poisoned(batch, crop, seed, step):
+        batch = real_crop(batch, crop, seed, step)
+        if step == 2:  # the third step sees a NaN in the ground truth
+            batch = dataclasses.replace(batch, gt=np.full_like(batch.gt, np.nan))
+        return batch
+
+    monkeypatch.setattr(loop, "random_crop", poisoned)
+    with pytest.raises(loop.TrainingDiverged, match="non-finite loss .* step 3.*last good checkpoint is step 2"):
+        loop.train(CONFIG, tmp_path, progress=False)
+    assert CheckpointManager(tmp_path / "checkpoints").latest_step() == 2
+
+
+def test_random_crop_is_deterministic_per_step():
+    rng = np.random.default_rng(0)
+    b = Batch(rng.integers(0, 255, (2, 10, 12, 3), dtype=np.uint8), rng.random((2, 10, 12), dtype=np.float32),
+              rng.random((2, 10, 12), dtype=np.float32), rng.random((2, 10, 12)) > 0.5)
+    a1, a2, c = loop.random_crop(b, (4, 5), 0, 7), loop.random_crop(b, (4, 5), 0, 7), loop.random_crop(b, (4, 5), 0, 8)
+    assert a1.gt.shape == (2, 4, 5)
+    np.testing.assert_array_equal(a1.gt, a2.gt)
+    assert not np.array_equal(a1.gt, c.gt)
+
+
+MULTI_DEVICE_SCRIPT = textwrap.dedent(
+    """
+    import dataclasses, sys, tempfile
+    import jax, numpy as np
+    sys.path.insert(0, {tests!r})
+    from test_train import CONFIG
+    from lipjax.data.pipeline import make_data_mesh
+    from lipjax.train import loop
+    assert len(jax.devices()) == 4, jax.devices()
+    config = dataclasses.replace(CONFIG, batch_size=4, g_steps=2, d_steps=0, adv_steps=0, eval_every=0)
+    one = loop.train(config, tempfile.mkdtemp(), progress=False, mesh=make_data_mesh(jax.devices()[:1]))
+    four = loop.train(config, tempfile.mkdtemp(), progress=False, mesh=make_data_mesh())
+    diffs = [float(np.abs(np.asarray(a) - np.asarray(b)).max()) for a, b in
+             zip(jax.tree_util.tree_leaves(one.g_params), jax.tree_util.tree_leaves(four.g_params))]
+    moved = [float(np.abs(np.asarray(a) - np.asarray(b)).max()) for a, b in
+             zip(jax.tree_util.tree_leaves(one.g_params), jax.tree_util.tree_leaves(loop.init_state(config).g_params))]
+    print("MAXDIFF", max(diffs), "MAXMOVE", max(moved))
+    """
+)
+
+
+def test_four_devices_match_one_device():
+    env = dict(os.environ)
+    env["XLA_FLAGS"] = (env.get("XLA_FLAGS", "") + " --xla_force_host_platform_device_count=4").strip()
+    script = MULTI_DEVICE_SCRIPT.format(tests=os.path.dirname(__file__))
+    out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    line = [l for l in out.stdout.splitlines() if l.startswith("MAXDIFF")][0].split()
+    max_diff, max_move = float(line[1]), float(line[3])
+    assert max_move > 1e-4  # training moved the parameters ...
+    assert max_diff < 1e-4 * max(1.0, max_move) + 1e-5  # ... identically up to float reduction order
