@@ -10,6 +10,7 @@ metres with 0 = no sample; output (B, H, W) float32 metres.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Any, Literal
 
@@ -57,11 +58,12 @@ class LIPConfig:
 
 def init(config: LIPConfig, key: jax.Array) -> Params:
     """Random parameters: one prox set per iteration (independent keys), or one shared set."""
+    # Parameter shapes never depend on the image size (fully convolutional priors); a small one keeps init cheap.
+    init_one = functools.partial(config.prior.init, image_shape=(64, 64))
     if config.shared_prox:
-        prox = config.prior.init(key)
+        prox = init_one(key)
     else:
-        keys = jax.random.split(key, config.num_iterations)
-        prox = jax.vmap(config.prior.init)(keys)
+        prox = jax.vmap(init_one)(jax.random.split(key, config.num_iterations))
     params = {"prox": prox}
     if config.learn_rho:
         params["log_rho"] = jnp.full((config.num_iterations,), math.log(config.rho_init), jnp.float32)

@@ -15,7 +15,7 @@ from lipjax.baselines.classical import (
     nearest_fill,
 )
 from lipjax.baselines.colorization import luma, neighbour_weights, nested_dissection_order, _OFFSETS
-from lipjax.baselines.ipbasic import auto_radius_px, diamond_kernel
+from lipjax.baselines.ipbasic import auto_radii_px, diamond_kernel
 from lipjax.baselines.registry import COMPLETERS, make_completer
 
 
@@ -175,14 +175,20 @@ def test_ipbasic_fills_everything_from_few_samples_and_prefers_near_surfaces():
     assert nearest_fill(s)[10, 9] == 9.0
 
 
-def test_ipbasic_radius_adapts_to_density():
+def test_ipbasic_radii_adapt_to_density_and_layout():
     dense = np.zeros((64, 64), np.float32)
-    dense[::4, ::4] = 5.0  # a sample every 4 px: gaps of <= 2.8 px
+    dense[::4, ::4] = 5.0  # a sample every 4 px: |dy| (and |dx|) to the nearest sample is 2 for < 25 % of pixels
     sparse = np.zeros((64, 64), np.float32)
     sparse[::16, ::16] = 5.0
-    r_dense, r_sparse = auto_radius_px(dense), auto_radius_px(sparse)
-    assert r_dense == 3 and r_sparse > 2 * r_dense
+    lines = np.zeros((64, 64), np.float32)
+    lines[::12, :] = 5.0  # scan lines 12 rows apart, dense along each line
+    assert auto_radii_px(dense) == (1, 1)
+    ry, rx = auto_radii_px(sparse)
+    assert ry == rx and ry >= 6
+    ry, rx = auto_radii_px(lines)
+    assert rx == 1 and ry >= 4  # anisotropic: tall, thin kernels for LiDAR lines
     np.testing.assert_array_equal(diamond_kernel(1), [[0, 1, 0], [1, 1, 1], [0, 1, 0]])
+    np.testing.assert_array_equal(diamond_kernel(2, 1), [[0, 1, 0], [0, 1, 0], [1, 1, 1], [0, 1, 0], [0, 1, 0]])
 
 
 # ---------------------------------------------------------------- colourisation
