@@ -92,7 +92,7 @@ def main(argv=None) -> None:
             ax.axis("off")
     fig.tight_layout()
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    fig.savefig(args.out, dpi=110)
+    fig.savefig(args.out, dpi=80)
     print(f"wrote {os.path.abspath(args.out)}")
 
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import math
-from typing import Protocol as _TypingProtocol, Sequence
+from typing import Any, Protocol as _TypingProtocol, Sequence
 
 import cv2
 import numpy as np
@@ -287,3 +287,17 @@ def tartanair_split(trajectories: Sequence[str], frame_counts: Sequence[int] | N
         assignment[name] = next((split for bound, split in bounds if midpoint < bound), bounds[-1][1])
         done += counts[name]
     return assignment
+
+
+class ProtocolView:
+    """An indexable data set seen through a protocol: view[i] = protocol(dataset[i]) (lazy, nothing cached)."""
+
+    def __init__(self, dataset: Any, protocol: "Protocol | str"):
+        self.dataset = dataset
+        self.protocol = get_protocol(protocol) if isinstance(protocol, str) else protocol
+
+    def __len__(self) -> int:
+        return len(self.dataset)
+
+    def __getitem__(self, index: int) -> Sample:
+        return self.protocol(self.dataset[index])

@@ -1,52 +1,66 @@
 """Procedural RGB-D scenes: lipjax's embedded default data set (no download, no files).
 
-Every frame is ray-cast from an analytic scene with a pinhole camera, in numpy, on the CPU:
+Every frame is ray-cast, in numpy on the CPU, from an analytic scene seen by a pinhole camera:
 
-* ``indoor``: a room (floor, four walls, ceiling) with furniture built from boxes, cylinders and spheres
-  against the walls and in the room (cabinets, bookshelves, wardrobes, desks, tables, chairs, beds, sofas,
-  kitchen counters, fridges, TVs, lamps, plants, bins, balls, and clutter on the tops: books, cups, bottles,
-  fruit, monitors). NYU-v2-like intrinsics (`NYU_INTRINSICS` at 480x640, scaled to the render size), camera
-  0.95-1.75 m above the floor, pitch -26..+5 deg, yaw +-34 deg, roll ~1 deg; depth about 0.5-11 m, and
-  every pixel valid (the room is closed).
-* ``outdoor``: a straight street (urban, residential or open road): asphalt road with lane markings,
-  raised sidewalks with curbs, buildings on both sides (facades with windows, shops, roofs), parked and
-  moving cars, poles, street lamps, signs, trees, hedges, bushes, fences, pedestrians, distant hills and
-  a sky with clouds. KITTI-like intrinsics (`KITTI_INTRINSICS` at 375x1242, scaled to the render size,
-  so at a 4:5 render size the pixels are anisotropic exactly as when a whole KITTI frame is resized),
-  camera 1.45-1.85 m above the road (KITTI: 1.65 m). Sky and surfaces farther than
-  `OUTDOOR_MAX_DEPTH_M` (80 m, a LiDAR's range) are invalid: depth 0.
+* ``indoor``: a room (floor, four walls, ceiling) with furniture built from boxes, cylinders and spheres,
+  against the walls and free-standing: cabinets, dressers, wardrobes, bookshelves, desks with chairs,
+  tables with chairs, beds, sofas, armchairs, kitchen counters with wall cabinets, fridges, TV stands,
+  floor lamps, plants, bins, stacked boxes, balls, wall shelves / frames, and clutter on the tops (books,
+  cups, bottles, fruit, monitors, lamps). NYU-v2-like camera (`NYU_INTRINSICS`), 0.95-1.75 m above the
+  floor, pitch -26..+5 deg, yaw +-34 deg, roll ~1 deg. Depth about 0.6-8.5 m (at most ~11 m in the
+  largest rooms); every pixel is valid (the room is closed).
+* ``outdoor``: a straight street, urban / residential / open road: asphalt with lane markings, tyre
+  tracks, patches and crosswalks; raised sidewalks with curbs; buildings on both sides (facades with
+  windows, shop fronts, stepped roofs; gaps, side yards, a building closing the street); parked and
+  moving cars (body, cabin with windows, wheels, lights, plates); street lamps, poles, signs; trees,
+  hedges, bushes, fences, pedestrians; distant hills; a sky with clouds and sun glow. KITTI-like camera
+  (`KITTI_INTRINSICS`), 1.45-1.85 m above the road (KITTI: 1.65 m), in a lane, yaw +-7 deg, pitch
+  -4..+2 deg, roll ~0.7 deg. Sky and surfaces farther than `OUTDOOR_MAX_DEPTH_M` (80 m, a LiDAR's range)
+  are invalid (depth 0); valid depth starts at ~3-5 m.
 
-RGB: procedural textures (per-object random colours; stripes, checkers, value noise, wood, tiles, bricks,
-books, facades, foliage; posters, rugs, doors, windows, whiteboards, lane markings and crosswalks, i.e.
-colour edges that are not depth edges), Lambertian shading from one or two lights (indoor: point lights
-with soft 1/(1 + d^2/r0^2) falloff; outdoor: the sun) plus hemispheric ambient, cast shadows (softened),
-a little Blinn-Phong gloss on some materials, distance haze outdoors, then a camera model: slight optical
-blur, random exposure and white balance, vignetting, signal-dependent Gaussian noise, a tone curve and
-sRGB-like gamma, 8-bit quantisation.
+RGB: procedural textures with per-object random colours (stripes, checkers, value noise, wood, tiles,
+bricks, books, cabinet fronts, facades, foliage, asphalt) and decals that are colour edges but not depth
+edges (posters, paintings, documents, whiteboards, doors, windows with curtains or blinds, skirting
+boards, rugs, blankets, lane markings, crosswalks, car lights and plates). Shading: Lambertian from one or
+two lights (indoor: point lights near the ceiling with soft 1 / (1 + d^2 / r0^2) falloff; outdoor: the
+sun, sometimes overcast) plus hemispheric ambient, cast shadows (softened), a Blinn-Phong-like gloss on
+some materials, emissive windows / lamps / screens, distance haze outdoors. Camera model: slight optical
+blur, random exposure and white balance, vignetting, signal-dependent Gaussian noise, a tone curve with a
+highlight shoulder and gamma 2.0-2.4, 8-bit quantisation.
+
+Camera intrinsics: `intrinsics_for(kind, H, W)` scales the reference camera to the render size with
+square pixels (largest centred crop of the reference frame with the render's aspect ratio, then an
+isotropic resize); see its docstring.
 
 Conventions:
   * Camera frame: x right, y down, z forward (OpenCV). Pixel (row v, column u) has its centre at (u, v);
     its ray is ((u - cx) / fx, (v - cy) / fy, 1) in the camera frame.
-  * `Sample.depth` is z-depth (distance along the optical axis, as in NYU and KITTI), not the ray length,
-    float32, metres; 0 = invalid. `Sample.valid = depth > 0`.
-  * World frame (only exposed through `SceneInfo`): y up, the floor / road surface is the plane y = 0;
-    x to the right of and z ahead of an unrotated camera. `SceneInfo.camera_to_world` maps camera-frame
-    points to world points (its rotation part has determinant -1, because camera y points down while world
-    y points up).
-  * Units: metres and pixels throughout.
+  * `Sample.depth` is z-depth (distance along the optical axis, as in NYU and KITTI), not the ray length:
+    float32 metres, 0 = invalid, `Sample.valid = depth > 0`.
+  * World frame (exposed through `SceneInfo` from `render_with_info`): y up, floor / road on the plane
+    y = 0, x to the right of and z ahead of an unrotated camera. `SceneInfo.camera_to_world` maps
+    camera-frame points to world points (its rotation has determinant -1: camera y is down, world y up).
+  * Units: metres and pixels.
 
 Determinism: a frame depends only on (kind, split, index, height, width). The scene (geometry, materials,
-lights, camera pose, camera-model parameters) is drawn from a numpy Generator seeded with
+lights, camera pose, camera-model parameters) comes from a numpy Generator seeded with
 sha256("lipjax/synthetic/v1/{kind}/{split}/{index}") and does not depend on the render size; the sensor
-noise is drawn from a second stream of the same seed. Python's salted hash() is never used, so the output
-is bit-identical across processes and runs (for a fixed numpy version). Splits use different seeds, so
-train / val / test never share a scene.
+noise comes from a second stream of the same seed. Python's salted hash() is never used, so frames are
+bit-identical across processes and runs (for a fixed numpy / OpenCV version). Each split has its own
+seeds: train, val and test never share a scene.
 
-Speed (measured with `taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py`, one core of the
-development machine, see that script): see `benchmarks/synthetic_fps.py`; at 256x320 about
-MEASURED_FPS_PLACEHOLDER.
+Approximations made for speed (all deterministic): shadow rays are cast for one pixel in each 2x2 block;
+outdoors, objects wholly farther than 70 m cast no shadow; the sky is shaded at 1/4 resolution; objects
+covering fewer than 32 pixels get their material's mean colour instead of the full texture.
 
-Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`, constants.
+Speed (`taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py`, one pinned core of the 2-CPU
+development machine, measured while other jobs kept its load average near 6): frames/s of CPU time, i.e.
+what one dedicated core delivers, 256x320: indoor 30, outdoor 22; 128x160: indoor 68, outdoor 26 (wall
+clock was half of that, the process getting about half of the shared core). Outdoor frames cost more:
+~120 objects against ~30 indoors, and part of the cost is per object, not per pixel.
+
+Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`, `SceneInfo`,
+`LABELS` and the constants below.
 """
 from __future__ import annotations
 
@@ -55,7 +69,7 @@ import dataclasses
 import functools
 import hashlib
 import math
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Iterator
 
 import cv2
 import numpy as np
@@ -120,6 +134,7 @@ LABELS = (
 _F32 = np.float32
 _EPS = 1e-4  # minimum ray parameter of a hit (metres of z-depth for camera rays)
 _NEAR = 0.02  # near plane used for screen-space culling (metres)
+_TINY_PIXELS = 32  # objects covering fewer pixels are shaded with their material's mean colour
 
 
 # ----------------------------------------------------------------------------------------------- public API
@@ -365,12 +380,8 @@ def _mix(c1: np.ndarray, c2: np.ndarray, w: np.ndarray) -> np.ndarray:
     return c1 + (c2 - c1) * w
 
 
-def _lin(rgb) -> np.ndarray:
-    """sRGB-ish [0, 1] colour -> linear float32 column (3, 1)."""
-    return np.array([[min(max(float(c), 0.0), 1.0) ** 2.2] for c in rgb], _F32)
-
-
 def _hsv(h, s, v) -> np.ndarray:
+    """HSV in [0, 1] (sRGB-like) -> linear float32 colour column (3, 1)."""
     rgb = colorsys.hsv_to_rgb(h % 1.0, min(max(s, 0.0), 1.0), min(max(v, 0.0), 1.0))
     return np.array([[rgb[0] ** 2.2], [rgb[1] ** 2.2], [rgb[2] ** 2.2]], _F32)
 
@@ -416,6 +427,17 @@ def _c_furniture(rng) -> np.ndarray:
 Pattern = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
+def _with_mean(fn: Pattern, mean) -> Pattern:
+    """Attaches a representative colour (3, 1): objects covering a few pixels are shaded with it."""
+    fn.mean = np.asarray(mean, _F32).reshape(3, 1)
+    return fn
+
+
+def _mean_of(fn: Pattern) -> np.ndarray:
+    m = getattr(fn, "mean", None)
+    return m if m is not None else np.full((3, 1), 0.3, _F32)
+
+
 def _p_solid(rng, c, amp=0.06) -> Pattern:
     ox, oy, f = rng.uniform(0, 256), rng.uniform(0, 256), rng.uniform(0.8, 3.0)
 
@@ -425,7 +447,7 @@ def _p_solid(rng, c, amp=0.06) -> Pattern:
         n = _vnoise(u * f + ox, v * f + oy)
         return c * (1.0 + 2.0 * amp * (n - 0.5))
 
-    return fn
+    return _with_mean(fn, c)
 
 
 def _p_noise(rng, c1, c2, freq, octaves=2, contrast=1.0, stretch=1.0) -> Pattern:
@@ -435,7 +457,7 @@ def _p_noise(rng, c1, c2, freq, octaves=2, contrast=1.0, stretch=1.0) -> Pattern
         n = _fbm(u * (freq * stretch) + ox, v * freq + oy, octaves, fp * (freq * stretch))
         return _mix(c1, c2, np.clip(0.5 + (n - 0.5) * (2.0 * contrast), 0.0, 1.0))
 
-    return fn
+    return _with_mean(fn, 0.5 * (c1 + c2))
 
 
 def _p_stripes(rng, c1, c2, period, duty=0.5, angle=0.0, amp=0.04) -> Pattern:
@@ -446,7 +468,7 @@ def _p_stripes(rng, c1, c2, period, duty=0.5, angle=0.0, amp=0.04) -> Pattern:
         w = _square(u * ca + v * sa, period, duty, fp)
         return _mix(c2, c1, w) * base(u, v, fp)
 
-    return fn
+    return _with_mean(fn, duty * c1 + (1.0 - duty) * c2)
 
 
 def _p_checker(rng, c1, c2, period, angle=0.0, amp=0.04) -> Pattern:
@@ -458,7 +480,7 @@ def _p_checker(rng, c1, c2, period, angle=0.0, amp=0.04) -> Pattern:
         b = _square(v * ca - u * sa, 2 * period, 0.5, fp)
         return _mix(c1, c2, a + b - 2 * a * b) * base(u, v, fp)
 
-    return fn
+    return _with_mean(fn, 0.5 * (c1 + c2))
 
 
 def _p_tiles(rng, c_tile, c_grout, su, sv, grout, var=0.08, offset=0.0, amp=0.05) -> Pattern:
@@ -475,7 +497,7 @@ def _p_tiles(rng, c_tile, c_grout, su, sv, grout, var=0.08, offset=0.0, amp=0.05
         tile = c_tile * (1.0 + 2.0 * var * (h - 0.5)) * base(u, v, fp)
         return tile + (c_grout - tile) * g
 
-    return fn
+    return _with_mean(fn, c_tile)
 
 
 def _p_wood(rng, c_light, c_dark, plank_w, plank_len, along_v=False, gap=0.004) -> Pattern:
@@ -498,7 +520,7 @@ def _p_wood(rng, c_light, c_dark, plank_w, plank_len, along_v=False, gap=0.004) 
         g = np.maximum(_square(v, plank_w, gap / plank_w, fp), _square(uu, plank_len, gap / plank_len, fp))
         return col_ * (1.0 - 0.45 * g)
 
-    return fn
+    return _with_mean(fn, 0.5 * (c_light + c_dark))
 
 
 def _p_books(rng, c_shelf, shelf_h, board) -> Pattern:
@@ -519,7 +541,7 @@ def _p_books(rng, c_shelf, shelf_h, board) -> Pattern:
         out = np.where(present, book, back)
         return np.where(vv < board, c_shelf, out)
 
-    return fn
+    return _with_mean(fn, 0.7 * palette.mean(axis=1, keepdims=True))
 
 
 def _p_fronts(rng, body: Pattern, w, h, cols, rows, plinth, gap_c, handle_c) -> Pattern:
@@ -543,7 +565,7 @@ def _p_fronts(rng, body: Pattern, w, h, cols, rows, plinth, gap_c, handle_c) -> 
         out[:, hm] = handle_c
         return out
 
-    return fn
+    return _with_mean(fn, _mean_of(body))
 
 
 def _p_poster(rng) -> Pattern:
@@ -608,7 +630,7 @@ def _p_poster(rng) -> Pattern:
             out[:, m] = fc
         return out
 
-    return fn
+    return _with_mean(fn, _mean_of(base))
 
 
 def _p_window(rng) -> Pattern:
@@ -644,14 +666,14 @@ def _p_window(rng) -> Pattern:
             emit *= 1.0 - 0.8 * slats
         return out, emit
 
-    return fn
+    return _with_mean(fn, sky)
 
 
 def _p_foliage(rng) -> Pattern:
     h = rng.uniform(0.17, 0.33)
-    dark = _hsv(h + rng.uniform(-0.03, 0.03), rng.uniform(0.4, 0.8), rng.uniform(0.06, 0.22))
-    light = _hsv(h + rng.uniform(-0.05, 0.02), rng.uniform(0.35, 0.75), rng.uniform(0.3, 0.65))
-    return _p_noise(rng, dark, light, rng.uniform(2.5, 7.0), 2, rng.uniform(1.0, 1.8))
+    dark = _hsv(h + rng.uniform(-0.03, 0.03), rng.uniform(0.35, 0.75), rng.uniform(0.08, 0.22))
+    light = _hsv(h + rng.uniform(-0.05, 0.02), rng.uniform(0.3, 0.65), rng.uniform(0.25, 0.5))
+    return _p_noise(rng, dark, light, rng.uniform(3.0, 9.0), 2, rng.uniform(0.6, 1.1))
 
 
 # ----------------------------------------------------------------------------------------------- materials
@@ -819,10 +841,15 @@ class _Prim:
         return [self]
 
     def hull(self) -> np.ndarray:
-        """(8, 3) world points whose convex hull contains the primitive."""
-        if self.mode == 0:
-            return _BOX_CORNERS * self.local_box() + self.c
-        return (_BOX_CORNERS * self.local_box()) @ self.R.T + self.c
+        """(8, 3) world points whose convex hull contains the primitive (cached: primitives never move)."""
+        h = self.__dict__.get("_hull")
+        if h is None:
+            if self.mode == 0:
+                h = _BOX_CORNERS * self.local_box() + self.c
+            else:
+                h = (_BOX_CORNERS * self.local_box()) @ self.R.T + self.c
+            self._hull = h
+        return h
 
 
 class _Box(_Prim):
@@ -858,6 +885,27 @@ class _Box(_Prim):
         tn = np.maximum(tn, np.minimum(a, b))
         tf = np.minimum(tf, np.maximum(a, b))
         return np.where((tn <= tf) & (tn > eps), tn, np.inf)
+
+    def intersect_axis(self, ox: float, oy: float, oz: float, ix, iy, iz):
+        """Camera rays (scalar origin) against an axis-aligned box, given the inverse ray directions."""
+        hx, hy, hz = self.h
+        cx, cy, cz = self.c
+        a = ix * (cx - hx - ox)
+        b = ix * (cx + hx - ox)
+        tn = np.minimum(a, b)
+        tf = np.maximum(a, b)
+        a = iy * (cy - hy - oy)
+        b = iy * (cy + hy - oy)
+        np.maximum(tn, np.minimum(a, b), out=tn)
+        np.minimum(tf, np.maximum(a, b), out=tf)
+        a = iz * (cz - hz - oz)
+        b = iz * (cz + hz - oz)
+        if self.inside:
+            np.minimum(tf, np.maximum(a, b), out=tf)
+            return np.where(tf > _EPS, tf, np.inf)
+        np.maximum(tn, np.minimum(a, b), out=tn)
+        np.minimum(tf, np.maximum(a, b), out=tf)
+        return np.where((tn <= tf) & (tn > _EPS), tn, np.inf)
 
     def surface(self, px, py, pz):
         x, y, z = self.local_pt(px, py, pz)
@@ -955,12 +1003,18 @@ class _Spheres(_Prim):
         self.rs = np.asarray(radii, dtype=_F32).reshape(-1)
 
     def parts(self):
-        return [_Sphere(c, r) for c, r in zip(self.cs, self.rs)]
+        ps = self.__dict__.get("_parts")
+        if ps is None:
+            ps = self._parts = [_Sphere(c, r) for c, r in zip(self.cs.tolist(), self.rs.tolist())]
+        return ps
 
     def hull(self):
-        lo = (self.cs - self.rs[:, None]).min(0).astype(np.float64)
-        hi = (self.cs + self.rs[:, None]).max(0).astype(np.float64)
-        return 0.5 * (lo + hi) + _BOX_CORNERS * (0.5 * (hi - lo))
+        h = self.__dict__.get("_hull")
+        if h is None:
+            lo = (self.cs - self.rs[:, None]).min(0).astype(np.float64)
+            hi = (self.cs + self.rs[:, None]).max(0).astype(np.float64)
+            h = self._hull = 0.5 * (lo + hi) + _BOX_CORNERS * (0.5 * (hi - lo))
+        return h
 
     def intersect(self, ox, oy, oz, dx, dy, dz, eps):
         """All spheres at once, (k, ...) broadcasting: used for shadow rays, where one cull per cluster
@@ -1173,7 +1227,7 @@ def _rug(rng) -> Pattern:
             out[:, m] = bc
         return out
 
-    return fn
+    return _with_mean(fn, 0.5 * (c1 + c2))
 
 
 def _furniture_mat(rng, fronts=None) -> _Mat:
@@ -1522,10 +1576,10 @@ def _indoor_scene(rng) -> _Scene:
         return x0 > 0.0 and z0 > 0.0 and x1 < W and z1 < L and all(
             x1 <= a0 or x0 >= a1 or z1 <= b0 or z0 >= b1 for a0, a1, b0, b1 in taken)
 
-    n_wall = int(rng.integers(1, 9))
+    n_wall = int(rng.integers(3, 11))
     for _ in range(n_wall):
         kind, wr, dr, hr, _w = _pick(rng, _WALL_ITEMS)
-        for _try in range(4):
+        for _try in range(6):
             f = int(rng.choice([0, 1, 5, 4], p=[0.3, 0.3, 0.35, 0.05]))
             w, d, h = rng.uniform(*wr), rng.uniform(*dr), rng.uniform(*hr)
             h = min(h, Hc - 0.15)
@@ -1552,11 +1606,11 @@ def _indoor_scene(rng) -> _Scene:
             taken.append((x0, x0 + fx2, z0, z0 + fz2))
             _indoor_item(b, rng, kind, (gx, gz, gyaw), w, d, h)
             break
-    for _ in range(int(rng.integers(0, 5))):
+    for _ in range(int(rng.integers(1, 6))):
         kind, wr, dr, hr, _w = _pick(rng, _ROOM_ITEMS)
         w, d, h = rng.uniform(*wr), rng.uniform(*dr), rng.uniform(*hr)
         margin = 0.65 if kind == "table" else 0.1
-        for _try in range(4):
+        for _try in range(6):
             gx, gz = rng.uniform(0.2, W - 0.2), rng.uniform(0.2, L - 0.2)
             r = 0.5 * math.hypot(w, d) + margin
             if not free(gx - r, gx + r, gz - r, gz + r):
@@ -1583,9 +1637,9 @@ def _indoor_scene(rng) -> _Scene:
         pos = (rng.uniform(0.2, 0.8) * W, Hc - rng.uniform(0.15, 0.5), rng.uniform(0.3, 0.95) * L)
         temp = _hsv(rng.uniform(0.06, 0.15), rng.uniform(0.0, 0.35), 1.0) if rng.random() < 0.7 else \
             _hsv(rng.uniform(0.5, 0.65), rng.uniform(0.0, 0.2), 1.0)
-        lights.append(_Light(temp * rng.uniform(1.0, 2.5), position=pos, r0=rng.uniform(1.5, 4.0),
+        lights.append(_Light(temp * rng.uniform(1.5, 3.5), position=pos, r0=rng.uniform(1.5, 4.0),
                              shadow_blur=int(rng.integers(1, 4))))
-    ambient = _hsv(rng.uniform(0.0, 1.0), rng.uniform(0.0, 0.15), 1.0) * rng.uniform(0.15, 0.5)
+    ambient = _hsv(rng.uniform(0.0, 1.0), rng.uniform(0.0, 0.15), 1.0) * rng.uniform(0.12, 0.4)
 
     return _Scene(
         prims=b.prims, cam_pos=cam, cam_R=R, lights=lights, ambient=ambient, ambient_up=rng.uniform(0.0, 0.3),
@@ -1597,8 +1651,9 @@ def _camera_model(rng) -> dict:
         exposure=rng.uniform(0.1, 0.28),
         wb=np.array([rng.uniform(0.85, 1.15), 1.0, rng.uniform(0.85, 1.15)], _F32),
         blur=rng.uniform(0.05, 0.22),
-        noise_read=rng.uniform(0.001, 0.012),
-        noise_shot=rng.uniform(0.0, 0.03),
+        # in linear units, before the ~1/2.2 gamma that amplifies it in the shadows
+        noise_read=rng.uniform(0.0002, 0.002),
+        noise_shot=rng.uniform(0.002, 0.015),
         vignette=rng.uniform(0.0, 0.35),
         gamma=float(rng.choice([2.0, 2.2, 2.4])),
     )
@@ -1653,7 +1708,7 @@ def _p_facade(rng, wall: Pattern, length_u0: float) -> Pattern:
             out[:, band] = shop_c
         return out
 
-    return fn
+    return _with_mean(fn, 0.75 * _mean_of(wall) + 0.25 * ga)
 
 
 def _building_wall(rng) -> Pattern:
@@ -1687,7 +1742,7 @@ def _p_car_end(rng, paint_c, W, body_h, rear: bool) -> Pattern:
         out[:, (du < 0.26) & (v > body_h * 0.2) & (v < body_h * 0.2 + 0.11)] = plate_c
         return out
 
-    return fn
+    return _with_mean(fn, paint_c)
 
 
 def _p_glazed(frame_c, glass: Pattern, u0, v0, u1, v1, pillar=None) -> Pattern:
@@ -1704,15 +1759,22 @@ def _p_glazed(frame_c, glass: Pattern, u0, v0, u1, v1, pillar=None) -> Pattern:
             out[:, sel] = glass(u[sel], v[sel], fp[sel])
         return out
 
-    return fn
+    return _with_mean(fn, 0.5 * (frame_c + _mean_of(glass)))
 
 
-def _car(b: _Builder, rng, x, z, yaw, detail=True):
+def _car_kit(rng) -> dict:
+    """Materials all cars of a scene share (tyres, rims, undersides): evaluated once per frame."""
+    rim = _Mat(_p_solid(rng, _c_grey(rng, 0.3, 0.7), 0.0))
+    return {"dark": _Mat(_p_solid(rng, _c_grey(rng, 0.01, 0.06), 0.0)),
+            "tyre": _Mat(_p_solid(rng, _c_grey(rng, 0.02, 0.06), 0.0), faces={3: rim, 2: rim})}
+
+
+def _car(b: _Builder, rng, x, z, yaw, kit, detail=True):
     with b.assembly():
-        _car_parts(b, rng, x, z, yaw, detail)
+        _car_parts(b, rng, x, z, yaw, kit, detail)
 
 
-def _car_parts(b: _Builder, rng, x, z, yaw, detail):
+def _car_parts(b: _Builder, rng, x, z, yaw, kit, detail):
     L = rng.uniform(3.8, 4.9)
     W = rng.uniform(1.65, 1.9)
     kind = rng.random()
@@ -1727,8 +1789,10 @@ def _car_parts(b: _Builder, rng, x, z, yaw, detail):
 
     def glass(u, v, fp):  # darker towards the bottom: a cheap stand-in for reflections
         return _mix(g, g2, np.minimum(v * (1.0 / cab_h), 1.0))
+
+    _with_mean(glass, 0.5 * (g + g2))
     spec, shin = rng.uniform(0.2, 0.6), rng.uniform(30, 90)
-    dark = _Mat(_p_solid(rng, _c_grey(rng, 0.01, 0.06), 0.0))
+    dark = kit["dark"]
     # local -z (face 4) is the rear, +z (face 5) the front: a car with yaw 0 drives away from the camera
     body = _Mat(paint, spec=spec, shin=shin, faces={
         2: dark, 4: _Mat(_p_car_end(rng, col, W, body_h, True), spec=spec, shin=shin),
@@ -1744,8 +1808,7 @@ def _car_parts(b: _Builder, rng, x, z, yaw, detail):
     b.box((0, clear + body_h + cab_h / 2, cz), (W * 0.45, cab_h / 2, cl / 2), _VEHICLE, cab, group=group)
     if detail:  # wheels: one cylinder per axle, visible below the body
         wr = rng.uniform(0.3, 0.36)
-        rim = _Mat(_p_solid(rng, _c_grey(rng, 0.3, 0.7), 0.0))
-        tyre = _Mat(_p_solid(rng, _c_grey(rng, 0.02, 0.06), 0.0), faces={3: rim, 2: rim})
+        tyre = kit["tyre"]
         axle_R = _rot_z(math.pi / 2)
         for sz in (-1, 1):
             b.cyl((0, wr, sz * (L / 2 - 0.8)), wr, W / 2 - 0.02, _VEHICLE, tyre, group=group, R=axle_R, cast=False)
@@ -1850,6 +1913,8 @@ def _outdoor_scene(rng) -> _Scene:
         col[:, road] = rc
         return col
 
+    _with_mean(ground, asphalt)
+
     b.prims.append(_Ground(np.array([_ROAD, _ROAD, _ROAD, _ROAD, _ROAD, _ROAD], np.int8), _Mat(ground)))
     # Ground labels beyond the road are patched in _render via the terrain_x bound.
 
@@ -1930,20 +1995,22 @@ def _outdoor_scene(rng) -> _Scene:
         n = int(rng.integers(1, 4))
         cs, rs = [], []
         for _ in range(n):
-            r = rng.uniform(150, 500)
-            cs.append((rng.uniform(-400, 400), -r + rng.uniform(15, 60), z_end + rng.uniform(100, 600) + r))
+            r = rng.uniform(300, 900)
+            cs.append((rng.uniform(-500, 500), -r + rng.uniform(8, 40), z_end + rng.uniform(250, 900) + r))
             rs.append(r)
         b.spheres(cs, rs, _TERRAIN, hill, cast=False)
 
     # Cars: parked along the curbs, and in the lanes.
+    kit = _car_kit(rng)
     for s in (-1, 1):
         if park <= 0 or rng.random() < 0.2:
             continue
         z = rng.uniform(1.0, 10.0)
         n = 0
-        while z < min(z_end, 90.0) and n < 10:
+        while z < min(z_end, 75.0) and n < 8:
             x = s * (half - rng.uniform(0.95, 1.2))
-            _car(b, rng, x, z + 2.3, rng.normal(0.0, 0.03) + (0.0 if rng.random() < 0.7 else math.pi), detail=z < 30)
+            _car(b, rng, x, z + 2.3, rng.normal(0.0, 0.03) + (0.0 if rng.random() < 0.7 else math.pi), kit,
+                 detail=z < 30)
             z += rng.uniform(5.0, 6.0) + (rng.uniform(0, 15) if rng.random() < 0.3 else rng.uniform(0.3, 2.0))
             n += 1
     for k in range(lanes):
@@ -1952,7 +2019,7 @@ def _outdoor_scene(rng) -> _Scene:
                 continue
             z = rng.uniform(8.0, 60.0)
             _car(b, rng, s * (k + 0.5) * lane_w + rng.normal(0, 0.2), z, (0.0 if s > 0 else math.pi) +
-                 rng.normal(0, 0.02), detail=z < 30)
+                 rng.normal(0, 0.02), kit, detail=z < 30)
 
     # Poles, street lamps, signs.
     pole_m = _Mat(_p_solid(rng, _c_grey(rng, 0.1, 0.6), 0.03), spec=0.2)
@@ -1960,7 +2027,7 @@ def _outdoor_scene(rng) -> _Scene:
         if rng.random() < 0.25:
             continue
         z = rng.uniform(3, 25)
-        spacing = rng.uniform(15, 40)
+        spacing = rng.uniform(20, 45)
         xp = s * (half + (rng.uniform(0.3, 0.6) if sw > 0 else rng.uniform(1.0, 3.0)))
         while z < min(z_end, 120.0):
             hp = rng.uniform(5, 9)
@@ -1989,10 +2056,10 @@ def _outdoor_scene(rng) -> _Scene:
         if rng.random() < (0.5 if style == "urban" else 0.25):
             continue
         z = rng.uniform(0, 15)
-        spacing = rng.uniform(8, 20) if style != "open" else rng.uniform(5, 12)
+        spacing = rng.uniform(10, 22) if style != "open" else rng.uniform(6, 14)
         xt = s * (half + (sw * rng.uniform(0.5, 0.8) if sw > 0 else rng.uniform(1.5, 6.0)))
         sp = species[int(rng.integers(0, len(species)))]
-        while z < min(z_end, 85.0):
+        while z < min(z_end, 75.0):
             _tree(b, rng, xt + rng.normal(0, 0.3 if sw > 0 else 2.0), z, sp, rng.uniform(0.7, 1.3))
             z += spacing * rng.uniform(0.7, 1.3)
     for _ in range(int(rng.integers(0, 6)) if style != "urban" else int(rng.integers(0, 3))):
@@ -2052,7 +2119,7 @@ def _outdoor_scene(rng) -> _Scene:
         prims=b.prims, cam_pos=cam, cam_R=R,
         lights=[_Light(sun_c, direction=sun_dir, shadow_blur=1 if not overcast else 4)],
         ambient=ambient, ambient_up=rng.uniform(0.2, 0.5), extent=z_end + 600.0, sky=sky,
-        haze_dist=rng.uniform(150.0, 600.0), haze_color=sky_hor * sky_gain * 0.8, max_depth=OUTDOOR_MAX_DEPTH_M,
+        haze_dist=rng.uniform(300.0, 1500.0), haze_color=sky_hor * sky_gain * 0.8, max_depth=OUTDOOR_MAX_DEPTH_M,
         terrain_x=ev, shadow_range=70.0, **_camera_model(rng))
 
 
@@ -2152,6 +2219,7 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
     dz = (r[6] * xn)[None, :] + (r[7] * yn + r[8])[:, None]
 
     # ---- visibility: per primitive, all pixels of its screen rectangle at once; keep the nearest
+    inv_dx, inv_dy, inv_dz = 1.0 / dx, 1.0 / dy, 1.0 / dz  # shared by all axis-aligned boxes
     zbuf = np.full((H, W), np.inf, _F32)
     ids = np.full((H, W), -1, np.int16)
     world_to_cam = Rm.T
@@ -2175,7 +2243,10 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
         zb = zbuf[sl]
         if zmin[i] < np.inf and zb.max() <= zmin[i]:
             continue
-        t = p.intersect(ox, oy, oz, dx[sl], dy[sl], dz[sl], _EPS)
+        if p.__class__ is _Box and p.mode == 0:
+            t = p.intersect_axis(ox, oy, oz, inv_dx[sl], inv_dy[sl], inv_dz[sl])
+        else:
+            t = p.intersect(ox, oy, oz, dx[sl], dy[sl], dz[sl], _EPS)
         closer = t < zb
         np.copyto(zb, t, where=closer)
         np.copyto(ids[sl], k, where=closer)
@@ -2213,8 +2284,16 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
                 lst.append(val)
         if geo[0]:
             r0_, r1_ = starts[k] - starts[0], starts[k1] - starts[0]
-            u, v, face = (g[0] if len(g) == 1 else np.concatenate(g) for g in geo)
-            a, e, s, h = prims[k].mat.evaluate(u, v, face, sfp[r0_:r1_])
+            mat = prims[k].mat
+            mean = getattr(mat.pattern, "mean", None)
+            if r1_ - r0_ < _TINY_PIXELS and mean is not None and mat.emit <= 0:
+                # a few pixels: the texture would not show, its call overhead would
+                n = r1_ - r0_
+                a, e, s, h = (np.broadcast_to(mean, (3, n)), np.zeros(n, _F32), np.full(n, mat.spec, _F32),
+                              np.full(n, mat.shin, _F32))
+            else:
+                u, v, face = (g[0] if len(g) == 1 else np.concatenate(g) for g in geo)
+                a, e, s, h = mat.evaluate(u, v, face, sfp[r0_:r1_])
             for lst, val in zip((res[0], res[4], res[5], res[6]), (a, e, s, h)):
                 lst.append(val)
         k = k1
@@ -2312,7 +2391,7 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
     gain = scene.exposure / max(lum, 1e-6)
     img *= 1.0 - scene.vignette * _vignette(H, W)
     img *= (gain * scene.wb)[:, None, None]
-    sigma = np.sqrt(img * scene.noise_shot ** 2 + scene.noise_read ** 2)
+    sigma = np.sqrt(np.maximum(img, 0.0) * scene.noise_shot ** 2 + scene.noise_read ** 2)
     n = img.size
     bank = _noise_bank()
     if n <= bank.size // 2:
@@ -2354,17 +2433,21 @@ def _shadows(scene: _Scene, light: _Light, recv, px, py, pz, nx, ny, nz, intr, H
     lit = np.ones((H, W), _F32)
     litf, recvf = lit.ravel(), recv.ravel()  # views
     pxf, pyf, pzf, nxf, nyf, nzf = (a.ravel() for a in (px, py, pz, nx, ny, nz))
-    casters, hulls = [], []
-    for group in members.values():
-        pts = np.concatenate([p.hull() for p in group])
-        lo, hi = pts.min(0), pts.max(0)
-        if np.maximum(lo - scene.cam_pos, scene.cam_pos - hi).max() >= scene.shadow_range:
-            continue  # wholly far from the camera: its shadow would be a few pixels
-        casters.append(group)
-        hulls.append(0.5 * (lo + hi) + _BOX_CORNERS * (0.5 * (hi - lo)))
-    if not casters or not recv.any():
+    if not members or not recv.any():
         return lit
-    hulls = np.stack(hulls)
+    groups = list(members.values())
+    flat = [p for g in groups for p in g]
+    ph = np.stack([p.hull() for p in flat])  # (P, 8, 3)
+    first = np.cumsum([0] + [len(g) for g in groups[:-1]])
+    lo = np.minimum.reduceat(ph.min(1), first, axis=0)  # per assembly world AABB
+    hi = np.maximum.reduceat(ph.max(1), first, axis=0)
+    # assemblies wholly far from the camera cast no shadow (it would be a few pixels)
+    keep = np.maximum(lo - scene.cam_pos, scene.cam_pos - hi).max(1) < scene.shadow_range
+    if not keep.any():
+        return lit
+    casters = [g for g, k in zip(groups, keep.tolist()) if k]
+    lo, hi = lo[keep], hi[keep]
+    hulls = 0.5 * (lo + hi)[:, None, :] + _BOX_CORNERS[None] * (0.5 * (hi - lo))[:, None, :]
     if light.direction is not None:
         L = np.asarray(light.direction)
         s = (hulls[..., 1].max(1) + 0.1) / max(L[1], 0.05)

@@ -24,7 +24,8 @@ of the shifted priors), so ADMM keeps a well-defined prior.
 The RGB image is ignored: this prior is the image-agnostic baseline.
 
 Parameters: `init` returns {"threshold": float32 scalar tau in metres} (starting at `threshold_m`), so the
-threshold can be swept or learned per iteration like any prox parameter; negative values act as 0.
+threshold can be swept or learned per iteration like any prox parameter (the solver stacks K of them); one
+scalar serves the whole batch; negative values act as 0.
 """
 from __future__ import annotations
 

@@ -1,0 +1,109 @@
+"""Shared plumbing of the experiment entry points: evaluate methods, write results.json / table.md / figures.
+
+Experiments stay thin: they build a config, pick a data set, a protocol and a sampler, and call these.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+import platform
+import time
+from typing import Any, Sequence
+
+import numpy as np
+
+from lipjax.data.sample import Sample
+from lipjax.evaluate import EvalResult, evaluate, markdown_table
+from lipjax.methods import get_method
+
+
+def evaluate_methods(
+    methods: Sequence[str], dataset, sampler, *, min_depth_m: float, max_depth_m: float, limit: int | None,
+    seed: int = 0,
+) -> dict[str, EvalResult]:
+    """Runs every named method on the same frames and the same sparse inputs."""
+    results = {}
+    for name in methods:
+        completer = get_method(name)
+        t0 = time.perf_counter()
+        results[name] = evaluate(completer, dataset, sampler, min_depth_m=min_depth_m, max_depth_m=max_depth_m,
+                                 limit=limit, seed=seed)
+        print(f"[lipjax] {name}: rmse_m={results[name].metrics['rmse_m']:.4f} ({time.perf_counter() - t0:.0f} s)",
+              flush=True)
+    return results
+
+
+def parameter_counts(methods: Sequence[str]) -> dict[str, int | None]:
+    """Learned parameters per method (None for methods without learned parameters)."""
+    counts = {}
+    for name in methods:
+        m = get_method(name)
+        counts[name] = m.parameter_count() if hasattr(m, "parameter_count") and not name.startswith("lip-wavelet") else None
+    return counts
+
+
+def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],
+                  columns: Sequence[str], extra_columns: dict[str, dict[str, Any]] | None = None) -> str:
+    """Writes out/results.json (aggregated metrics with units in the keys + meta) and out/table.md; returns the table."""
+    out.mkdir(parents=True, exist_ok=True)
+    doc = {
+        "meta": {**meta, "hardware": f"{platform.machine()} {platform.processor() or ''}".strip(),
+                 "python": platform.python_version()},
+        "methods": {name: {**r.metrics, "ms_per_frame": r.ms_per_frame, "num_images": r.num_images,
+                           **(extra_columns or {}).get(name, {})} for name, r in results.items()},
+    }
+    (out / "results.json").write_text(json.dumps(_finite(doc), indent=1))
+    table = markdown_table(results, columns)
+    if extra_columns:
+        table = _append_columns(table, results, extra_columns)
+    header = f"{meta.get('title', '')}\n\n{meta.get('description', '')}\n\n"
+    (out / "table.md").write_text(header + table + "\n")
+    return table
+
+
+def _append_columns(table: str, results, extra: dict[str, dict[str, Any]]) -> str:
+    keys = sorted({k for v in extra.values() for k in v})
+    lines = table.splitlines()
+    lines[0] += "".join(f" {k} |" for k in keys)
+    lines[1] += "---:|" * len(keys)
+    for i, name in enumerate(results, start=2):
+        lines[i] += "".join(f" {_fmt(extra.get(name, {}).get(k))} |" for k in keys)
+    return "\n".join(lines)
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "n/a"
+    return f"{v:.3g}" if isinstance(v, float) else str(v)
+
+
+def _finite(x):
+    if isinstance(x, float) and not np.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    return x
+
+
+def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inputs: Sequence[np.ndarray],
+                       methods: Sequence[str], max_depth_m: float, max_error_m: float) -> None:
+    """The paper's Fig. 3 layout: per frame, RGB | sparse input | ground truth | each method's prediction and error."""
+    from lipjax import viz
+
+    rows = []
+    for sample, sparse in zip(samples, sparse_inputs):
+        row = [(sample.rgb, "RGB"), (viz.colorize_depth(sparse, 0.0, max_depth_m, dilate_px=2), "sparse input"),
+               (viz.colorize_depth(sample.depth, 0.0, max_depth_m), "ground truth")]
+        for name in methods:
+            pred = np.asarray(get_method(name)(sample.rgb, sparse))
+            row.append((viz.colorize_depth(pred, 0.0, max_depth_m), name))
+            row.append((viz.error_map(pred, sample.depth, sample.valid, max_error_m), f"{name} error"))
+        rows.append(row)
+    viz.save_grid(path, rows)
+
+
+def config_fields(config) -> dict[str, Any]:
+    return {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}

@@ -1,0 +1,506 @@
+"""The `lipjax` command: complete depth on your own images, evaluate, train, export, list models.
+
+    lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
+                    [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
+    lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
+    lipjax train --config NAME [...]            (= python -m experiments.train)
+    lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
+    lipjax models
+
+`complete`, inputs and outputs:
+  --rgb     colour image (.png / .jpg), or a folder of them.
+  --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
+              .png  16-bit, metres = value / S with S = --depth-scale (KITTI 256, NYU 1000, TUM 5000; also the
+                    names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
+              .npy  float metres (never scaled).
+  --out     the extension chooses the format:
+              X.npy        float32 metres.
+              X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
+                           (npy input); values above 65535 are clipped, with a warning.
+              X.color.png  8-bit colour picture (lipjax.viz.colorize_depth, turbo) over the fixed range
+                           --color-range (default 0 m to the model's max depth: 10 m indoor, 85 m outdoor);
+                           black = no depth.
+            With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
+            (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
+            Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
+            (rgb_00050.jpg <-> sync_depth_00050.png), as lipjax.data.folder.FolderDataset does.
+  --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
+            metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
+
+Image size: any. The model is fully convolutional and runs at the input resolution (the network pads to a
+multiple of 8 internally); a new size costs one compilation. `--max-side N` runs frames whose longer side
+exceeds N at a reduced size for speed: the RGB is area-resized; each measured depth pixel is moved to the
+pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are
+never averaged); the result is resized back (bilinear) and the measured pixels are then set to their
+measured values exactly. Without --max-side the output is the model's own (its x-update pulls measured pixels
+towards the measurements, paper eq. 6).
+
+Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
+print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+PROG = "lipjax"
+DEFAULT_PNG_OUT_SCALE = 256.0
+OUT_FORMATS = ("npy", "png", "color.png")
+
+
+class CLIError(Exception):
+    """A problem the user can fix; printed as one line, no traceback."""
+
+
+def _warn(message: str) -> None:
+    print(f"{PROG}: warning: {message}", file=sys.stderr)
+
+
+# ------------------------------------------------------------------------------------------- argument types
+
+
+def _depth_scale(text: str) -> float:
+    from lipjax.data.folder import KNOWN_DEPTH_SCALES
+
+    if text.lower() in KNOWN_DEPTH_SCALES:
+        return KNOWN_DEPTH_SCALES[text.lower()]
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number or one of {sorted(KNOWN_DEPTH_SCALES)}, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
+    return value
+
+
+# -------------------------------------------------------------------------------------------------- models
+
+
+def load_completer(model: str | None, iterations: int | None = None):
+    """The Completer for --model (None: the shipped default, else an untrained model with a warning)."""
+    import lipjax
+    from lipjax.inference import DEFAULT_MODEL
+
+    if model is None:
+        if DEFAULT_MODEL in lipjax.available_models():
+            completer = lipjax.load_model(DEFAULT_MODEL)
+        else:
+            _warn(f"no trained weights shipped ({DEFAULT_MODEL!r} is not in `lipjax models`): using an UNTRAINED "
+                  "model, whose output is only a smooth fill of the samples; pass --model NAME|PATH")
+            completer = lipjax.Completer.random()
+    else:
+        completer = lipjax.load_model(model)
+    if iterations is not None:
+        completer = completer.with_iterations(iterations)
+    return completer
+
+
+def _model_max_depth(completer) -> float:
+    return float(getattr(completer.config.prior, "max_depth_m", 10.0))
+
+
+# ------------------------------------------------------------------------------------------- frame helpers
+
+
+def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """Moves each measured pixel of a (H, W) sparse map to the pixel of a (h, w) grid its centre falls in.
+
+    Values are kept (never averaged or interpolated); where several samples land in one pixel the nearest
+    (smallest depth) wins, as a z-buffer. Returns (h, w) float32 metres, 0 = no sample.
+    """
+    sparse = np.asarray(sparse_m, np.float32)
+    big_h, big_w = sparse.shape
+    h, w = size
+    rows, cols = np.nonzero(sparse > 0)
+    z = sparse[rows, cols]
+    r = np.minimum(((rows + 0.5) * h / big_h).astype(np.int64), h - 1)
+    c = np.minimum(((cols + 0.5) * w / big_w).astype(np.int64), w - 1)
+    pixel = r * w + c
+    order = np.lexsort((z, pixel))
+    pixel, z = pixel[order], z[order]
+    first = np.ones(pixel.size, bool)
+    first[1:] = pixel[1:] != pixel[:-1]
+    out = np.zeros(h * w, np.float32)
+    out[pixel[first]] = z[first]
+    return out.reshape(h, w)
+
+
+def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
+    """Dense (H, W) float32 metres for one frame; with max_side, run downsized (see the module docstring)."""
+    import cv2
+
+    big_h, big_w = sparse_m.shape
+    if max_side is None or max(big_h, big_w) <= max_side:
+        return np.asarray(completer(rgb, sparse_m), np.float32)
+    s = max_side / max(big_h, big_w)
+    h, w = max(1, round(big_h * s)), max(1, round(big_w * s))
+    small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
+    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
+    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    measured = sparse_m > 0
+    dense[measured] = sparse_m[measured]
+    return dense.astype(np.float32)
+
+
+def _read_frame(rgb_path: Path, depth_path: Path, scale: float | None) -> tuple[np.ndarray, np.ndarray]:
+    from lipjax.data.folder import read_depth, read_rgb
+
+    rgb = read_rgb(rgb_path)
+    suffix = depth_path.suffix.lower()
+    if suffix == ".png" and scale is None:
+        raise CLIError(f"{depth_path}: a PNG depth map has no unit; pass --depth-scale S (metres = value / S): "
+                       "KITTI 256, NYU 1000, TUM 5000")
+    if suffix not in (".png", ".npy"):
+        raise CLIError(f"{depth_path}: unsupported depth format {suffix!r} (use a 16-bit .png with --depth-scale, or .npy in metres)")
+    sparse = read_depth(depth_path, scale if suffix == ".png" else None)
+    if sparse.shape != rgb.shape[:2]:
+        raise CLIError(f"{depth_path}: sparse depth is {sparse.shape[0]}x{sparse.shape[1]} but the RGB image {rgb_path} "
+                       f"is {rgb.shape[0]}x{rgb.shape[1]}; the depth must be aligned with the RGB image pixel for "
+                       "pixel (project your LiDAR into the camera: lipjax.pointcloud.project_lidar_to_depth)")
+    if not (sparse > 0).any():
+        raise CLIError(f"{depth_path}: the sparse depth map is empty (no pixel > 0); nothing to complete from")
+    return rgb, sparse
+
+
+def _output_format(path: Path) -> str:
+    name = path.name.lower()
+    for fmt in ("color.png", "npy", "png"):
+        if name.endswith("." + fmt):
+            return fmt
+    raise CLIError(f"--out {path}: unknown extension; use .npy (metres), .png (16-bit, scale S) or .color.png (picture)")
+
+
+def _write_depth(path: Path, dense: np.ndarray, fmt: str, out_scale: float, color_range: tuple[float, float]) -> None:
+    import cv2
+
+    from lipjax import viz
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "npy":
+        np.save(path, dense.astype(np.float32))
+    elif fmt == "color.png":
+        viz.write_png(path, viz.colorize_depth(dense, *color_range))
+    else:
+        raw = np.round(dense.astype(np.float64) * out_scale)
+        if raw.max() > 65535:
+            _warn(f"{path}: depth above {65535 / out_scale:.1f} m does not fit a 16-bit PNG at scale {out_scale:g}; "
+                  "clipped (use a smaller --depth-scale or .npy)")
+        if not cv2.imwrite(os.fspath(path), np.clip(raw, 0, 65535).astype(np.uint16)):
+            raise OSError(f"cannot write {path}")
+
+
+def _intrinsics_from_args(args):
+    from lipjax.data.folder import read_intrinsics_txt
+    from lipjax.data.sample import Intrinsics
+
+    if getattr(args, "intrinsics", None):
+        return Intrinsics(*args.intrinsics)
+    if getattr(args, "intrinsics_file", None):
+        return read_intrinsics_txt(args.intrinsics_file)
+    return None
+
+
+def _pair_folders(rgb_dir: Path, depth_dir: Path) -> list[tuple[Path, Path]]:
+    """(rgb, depth) paths paired by stem, else by trailing number (FolderDataset's rule), in natural order."""
+    from lipjax.data.folder import DEPTH_SUFFIXES, RGB_SUFFIXES, FolderDataset, _list, natural_key
+
+    rgbs, depths = _list(rgb_dir, RGB_SUFFIXES), _list(depth_dir, DEPTH_SUFFIXES)
+    if not rgbs:
+        raise CLIError(f"{rgb_dir}: no RGB images (.png/.jpg/.jpeg) in this folder")
+    if not depths:
+        raise CLIError(f"{depth_dir}: no depth maps (.png/.npy) in this folder")
+    if not set(rgbs) & set(depths):
+        rgbs = FolderDataset._rekey_by_number(rgbs, rgb_dir)
+        depths = FolderDataset._rekey_by_number(depths, depth_dir)
+    unpaired = sorted(set(rgbs) ^ set(depths), key=natural_key)
+    if unpaired:
+        examples = [(rgbs.get(k) or depths.get(k)).name for k in unpaired[:3]]
+        raise CLIError(f"{len(unpaired)} frame(s) have no RGB/depth partner, e.g. {examples} "
+                       "(frames pair by file stem, or by the number the stem ends with)")
+    return [(rgbs[k], depths[k]) for k in sorted(rgbs, key=natural_key)]
+
+
+# ------------------------------------------------------------------------------------------------ commands
+
+
+def _cmd_complete(args) -> int:
+    from lipjax.pointcloud import backproject_rgbd, write_ply
+
+    rgb_path, depth_path, out = Path(args.rgb), Path(args.depth), Path(args.out)
+    intrinsics = _intrinsics_from_args(args)
+    if args.ply and intrinsics is None:
+        raise CLIError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
+    for p in (rgb_path, depth_path):
+        if not p.exists():
+            raise CLIError(f"{p}: no such file or folder")
+    if rgb_path.is_dir() != depth_path.is_dir():
+        raise CLIError("--rgb and --depth must both be files or both be folders")
+    if rgb_path.is_dir():
+        pairs = _pair_folders(rgb_path, depth_path)
+        if out.exists() and not out.is_dir():
+            raise CLIError(f"--out {out}: with input folders, OUT must be a folder")
+        if args.ply and Path(args.ply).exists() and not Path(args.ply).is_dir():
+            raise CLIError(f"--ply {args.ply}: with input folders, --ply must be a folder")
+        fmt = args.out_format or ("png" if all(d.suffix.lower() == ".png" for _, d in pairs) else "npy")
+        jobs = [(r, d, out / f"{r.stem}.{fmt}", Path(args.ply) / f"{r.stem}.ply" if args.ply else None) for r, d in pairs]
+    else:
+        if args.out_format:
+            raise CLIError("--out-format is for folders; for one frame the extension of --out chooses the format")
+        fmt = _output_format(out)
+        jobs = [(rgb_path, depth_path, out, Path(args.ply) if args.ply else None)]
+    out_scale = args.depth_scale or DEFAULT_PNG_OUT_SCALE
+
+    completer = None  # loaded after the first frame is read: input errors come before the slow model load
+    frames = (_read_frame(r, d, args.depth_scale) for r, d, _, _ in jobs)
+    progress = jobs
+    if len(jobs) > 1 and not args.quiet:
+        from tqdm import tqdm
+
+        progress = tqdm(jobs, desc=f"{PROG} complete", unit="frame", file=sys.stderr)
+    for (rgb_file, _, out_file, ply_file), (rgb, sparse) in zip(progress, frames):
+        if completer is None:
+            completer = load_completer(args.model, args.iterations)
+            color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
+        dense = complete_frame(completer, rgb, sparse, args.max_side)
+        _write_depth(out_file, dense, fmt, out_scale, color_range)
+        if ply_file is not None:
+            ply_file.parent.mkdir(parents=True, exist_ok=True)
+            write_ply(ply_file, *backproject_rgbd(dense, rgb, intrinsics))
+    if len(jobs) == 1 and not args.quiet:
+        print(f"wrote {jobs[0][2]}" + (f" and {jobs[0][3]}" if jobs[0][3] else ""), file=sys.stderr)
+    elif not args.quiet:
+        print(f"wrote {len(jobs)} frame(s) to {out}", file=sys.stderr)
+    return 0
+
+
+class _Protocolled:
+    """A data set seen through a named protocol (crop / resize)."""
+
+    def __init__(self, dataset, protocol):
+        self.dataset, self.protocol = dataset, protocol
+
+    def __len__(self):
+        return len(self.dataset)
+
+    def __getitem__(self, i):
+        return self.protocol(self.dataset[i])
+
+
+def _cmd_evaluate(args) -> int:
+    from lipjax.data import protocols
+    from lipjax.data.sample import Intrinsics
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json
+
+    sampler = sampler_from_spec(args.sampler)
+    protocol = protocols.get_protocol(args.protocol) if args.protocol else None
+    if args.data in ("synthetic-indoor", "synthetic-outdoor"):
+        from lipjax.data.synthetic import SyntheticDataset
+
+        kind = args.data.split("-")[1]
+        height, width = args.size or (None, None)
+        size_kw = {"height": height, "width": width} if args.size else {}
+        dataset = SyntheticDataset(kind, args.split, **size_kw)
+        range_from = protocol or protocols.get_protocol(f"synthetic_{kind}")
+    else:
+        from lipjax.data.folder import FolderDataset
+
+        root = Path(args.data)
+        if not root.is_dir():
+            raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
+        intrinsics = _intrinsics_from_args(args)
+        if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
+            intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # metrics do not use intrinsics
+        dataset = FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics)
+        range_from = protocol
+    if protocol is not None:
+        dataset = _Protocolled(dataset, protocol)
+    min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
+    max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
+    if max_depth is None:
+        raise CLIError("give the evaluated depth range: --max-depth-m M (e.g. 10 indoors, 80 outdoors) or --protocol NAME")
+    columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
+    results = {}
+    for model in args.model or [None]:
+        completer = load_completer(model, args.iterations)
+        label = model if model is not None else completer.name
+        results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
+                                  limit=args.limit, progress=not args.quiet, seed=args.seed)
+    n = next(iter(results.values())).num_images
+    print(f"data: {args.data} ({n} frames), sampler: {args.sampler}, depth range: ({min_depth:g}, {max_depth:g}] m")
+    print()
+    print(markdown_table(results, columns=columns))
+    if args.json:
+        save_json(results, args.json)
+    return 0
+
+
+def _cmd_export(args) -> int:
+    from lipjax.export import export_completer, save_exported
+
+    completer = load_completer(args.model, args.iterations)
+    platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
+    exported = export_completer(completer, args.batch, args.height, args.width, platforms=platforms)
+    try:
+        path = save_exported(exported, args.out)
+    except ImportError as exc:
+        raise CLIError(str(exc)) from exc
+    if not args.quiet:
+        print(f"wrote {path} ({path.stat().st_size} bytes): rgb uint8 {(args.batch, args.height, args.width, 3)}, "
+              f"sparse float32 {(args.batch, args.height, args.width)} m -> depth m; platforms {list(exported.platforms)}",
+              file=sys.stderr)
+    return 0
+
+
+def _cmd_models(args) -> int:
+    from lipjax import model_io
+    from lipjax.inference import DEFAULT_MODEL
+
+    names = model_io.available()
+    if not names:
+        print(f"no shipped models in {model_io.WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. "
+              "Train one with `lipjax train --config lip_cnn_indoor`, or pass --model PATH to a saved model.")
+        return 0
+    for name in names:
+        doc = json.loads((model_io.WEIGHTS_DIR / f"{name}.json").read_text())
+        config, meta = doc.get("config", {}), doc.get("metadata", {})
+        rmse = meta.get("val_metrics", {}).get("rmse_m")
+        parts = [name + (" (default)" if name == DEFAULT_MODEL else ""),
+                 f"K={config.get('num_iterations')}", f"max_depth={config.get('prior', {}).get('max_depth_m')} m"]
+        if rmse is not None:
+            parts.append(f"val rmse_m={rmse:.4f} ({meta.get('val_sampler', '?')}, {meta.get('data', '?')})")
+        print("  ".join(parts))
+    return 0
+
+
+def _cmd_train(argv: list[str]) -> int:
+    try:
+        from experiments import train as train_module
+    except ImportError as exc:
+        raise CLIError(f"`lipjax train` needs the experiments package of the lipjax source checkout ({exc})") from exc
+    try:
+        train_module.main(argv)
+    except SystemExit as exit_:  # its argparse: --help or a usage error (already printed)
+        return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 2)
+    return 0
+
+
+# ------------------------------------------------------------------------------------------------- parsing
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from lipjax.data import protocols
+
+    parser = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
+    c.add_argument("--depth", required=True, help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
+    c.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
+                   help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output (default 256)")
+    c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path")
+    c.add_argument("--iterations", type=_positive_int, default=None, metavar="K", help="run the first K ADMM iterations")
+    c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
+    c.add_argument("--out-format", choices=OUT_FORMATS, default=None, help="per-frame format with folder inputs")
+    c.add_argument("--max-side", type=_positive_int, default=None, metavar="N", help="run larger frames downsized to this longer side")
+    c.add_argument("--color-range", type=float, nargs=2, default=None, metavar=("MIN_M", "MAX_M"),
+                   help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
+    c.add_argument("--ply", default=None, help="also write a coloured point cloud (.ply; a folder with folder inputs)")
+    intr = c.add_mutually_exclusive_group()
+    intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"), help="pixels, of the RGB image")
+    intr.add_argument("--intrinsics-file", default=None, metavar="F", help='"fx fy cx cy" or the 9 numbers of K')
+    c.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    c.set_defaults(func=_cmd_complete)
+
+    e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
+    e.add_argument("--model", action="append", default=None, help="repeat to compare models (default: the shipped default)")
+    e.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
+    e.add_argument("--data", default="synthetic-indoor",
+                   help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ (lipjax.data.folder layout)")
+    e.add_argument("--split", default="test", choices=("train", "val", "test"), help="synthetic split")
+    e.add_argument("--size", type=_positive_int, nargs=2, default=None, metavar=("H", "W"), help="synthetic render size (default 256 320)")
+    e.add_argument("--sampler", default="uniform:200", help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling)")
+    e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS), help="named crop/resize + depth range applied to each frame (lipjax.data.protocols)")
+    e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="for PNG ground truth in FOLDER")
+    intr = e.add_mutually_exclusive_group()
+    intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"))
+    intr.add_argument("--intrinsics-file", default=None, metavar="F")
+    e.add_argument("--min-depth-m", type=float, default=None)
+    e.add_argument("--max-depth-m", type=float, default=None, help="default: the protocol's (10 indoor, 80 outdoor)")
+    e.add_argument("--limit", type=_positive_int, default=None, metavar="N", help="evaluate the first N frames only")
+    e.add_argument("--seed", type=int, default=0, help="sampler seed")
+    e.add_argument("--columns", default=None, help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
+    e.add_argument("--json", default=None, metavar="FILE", help="also write all results as JSON")
+    e.add_argument("--quiet", action="store_true")
+    e.set_defaults(func=_cmd_evaluate)
+
+    sub.add_parser("train", add_help=False, help="train a model: lipjax train --config NAME (see lipjax train --help)")
+
+    x = sub.add_parser("export", help="export a model as StableHLO (jax.export) for a fixed input shape")
+    x.add_argument("--model", default=None)
+    x.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
+    x.add_argument("--height", type=_positive_int, required=True)
+    x.add_argument("--width", type=_positive_int, required=True)
+    x.add_argument("--batch", type=_positive_int, default=1)
+    x.add_argument("--platforms", default=None, help="comma-separated, e.g. cpu,cuda (default: this machine's)")
+    x.add_argument("--out", required=True, metavar="FILE.stablehlo")
+    x.add_argument("--quiet", action="store_true")
+    x.set_defaults(func=_cmd_export)
+
+    m = sub.add_parser("models", help="list the shipped models")
+    m.set_defaults(func=_cmd_models)
+    return parser
+
+
+def _one_line(exc: BaseException) -> str:
+    lines = [line.strip() for line in (str(exc) or type(exc).__name__).splitlines() if line.strip()]
+    return " | ".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the command line; returns the exit status (0 ok, 1 user error, 2 usage error)."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        if argv and argv[0] == "train":
+            args = None
+        else:
+            try:
+                args = build_parser().parse_args(argv)
+            except SystemExit as exit_:  # --help, or a usage error argparse has printed
+                return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 2)
+        try:
+            from lipjax.utils import enable_compilation_cache
+
+            enable_compilation_cache()
+        except OSError as exc:
+            _warn(f"no persistent compilation cache ({exc}); every run compiles from scratch")
+        return _cmd_train(argv[1:]) if args is None else args.func(args)
+    except (CLIError, ValueError, FileNotFoundError, OSError) as exc:  # InputError, DatasetError are ValueErrors
+        if os.environ.get("LIPJAX_DEBUG"):
+            raise
+        print(f"{PROG}: error: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,109 @@
+"""Exports a trained model's inference function as serialised StableHLO (`jax.export`), for a fixed input shape.
+
+    exported = export_completer(lipjax.load_model("lip-ad-indoor"), batch=1, height=480, width=640)
+    save_exported(exported, "lip-ad-indoor_1x480x640.stablehlo")
+    run = load_exported("lip-ad-indoor_1x480x640.stablehlo")
+    depth = run(rgb_uint8_bhw3, sparse_f32_bhw)                        # (B, H, W) float32 metres
+
+or from the shell: `lipjax export --model lip-ad-indoor --height 480 --width 640 --out model.stablehlo`.
+
+Choices:
+  - The parameters are baked into the program as constants, so the file is the whole model: nothing else to
+    ship or keep in step, and the function takes only the images. Re-export after retraining. (The file size is
+    about the parameter count x 4 bytes.)
+  - The signature is fixed: rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) in metres with 0 = no sample ->
+    dense depth float32 (B, H, W) metres, clamped at 0 like `Completer.__call__`. B, H, W are those given at
+    export; another size needs another export. Any H, W works (the network pads to a multiple of 8 inside).
+  - No input checks run inside the exported program (a sparse map in millimetres or all zeros gives garbage,
+    not an error); `load_exported`'s callable checks shapes and dtypes only. Use `lipjax.inference.check_inputs`
+    where lipjax is installed.
+  - Platforms: by default the platform of the exporting machine (`jax.export.default_export_platform()`);
+    pass `platforms=("cpu", "cuda")` for a file that runs on either.
+
+Serialising needs the `flatbuffers` package (an optional dependency of jax). Running it needs only jax, not
+this package (`load_exported` is a convenience around exactly this):
+
+    import jax, numpy as np
+    exported = jax.export.deserialize(open("model.stablehlo", "rb").read())
+    depth = np.asarray(exported.call(rgb_uint8, sparse_f32))
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+import pathlib
+from collections.abc import Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from lipjax import model as lip_model
+from lipjax.inference import Completer
+
+
+def export_completer(completer: Completer, batch: int, height: int, width: int,
+                     platforms: Sequence[str] | None = None) -> jax.export.Exported:
+    """Lowers the completer's inference function for inputs (batch, height, width) with its parameters baked in."""
+    for name, value in (("batch", batch), ("height", height), ("width", width)):
+        if int(value) < 1:
+            raise ValueError(f"{name} must be >= 1, got {value}")
+    config = completer.config
+    params = jax.tree_util.tree_map(jnp.asarray, completer.params)
+
+    def infer(rgb, sparse):
+        depth, _ = lip_model.apply(config, params, rgb, sparse)
+        return jnp.maximum(depth, 0.0)
+
+    specs = (jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
+             jax.ShapeDtypeStruct((batch, height, width), jnp.float32))
+    return jax.export.export(jax.jit(infer), platforms=platforms)(*specs)
+
+
+def _need_flatbuffers() -> None:
+    try:
+        import flatbuffers  # noqa: F401 - jax.export's (de)serialisation imports it lazily
+    except ImportError:
+        raise ImportError("saving or loading an exported model needs the 'flatbuffers' package: "
+                          "pip install flatbuffers") from None
+
+
+def save_exported(exported: jax.export.Exported, path: str | os.PathLike) -> pathlib.Path:
+    """Writes `exported.serialize()` to `path` (parent folders created)."""
+    _need_flatbuffers()
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(exported.serialize())
+    return path
+
+
+@dataclasses.dataclass(frozen=True)
+class ExportedCompleter:
+    """A deserialised exported model: `(rgb uint8 (B,H,W,3), sparse float32 (B,H,W) metres) -> depth (B,H,W)`."""
+
+    exported: jax.export.Exported
+
+    @property
+    def input_shape(self) -> tuple[int, int, int]:
+        """(B, H, W) the model was exported for."""
+        return tuple(int(d) for d in self.exported.in_avals[1].shape)  # type: ignore[return-value]
+
+    def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
+        rgb, sparse = np.asarray(rgb), np.asarray(sparse)
+        b, h, w = self.input_shape
+        if rgb.shape != (b, h, w, 3) or rgb.dtype != np.uint8:
+            raise ValueError(f"this exported model takes rgb uint8 {(b, h, w, 3)}, got {rgb.dtype} {rgb.shape}")
+        if sparse.shape != (b, h, w) or not np.issubdtype(sparse.dtype, np.floating):
+            raise ValueError(f"this exported model takes sparse float32 metres {(b, h, w)}, got {sparse.dtype} {sparse.shape}")
+        return np.asarray(self.exported.call(rgb, sparse.astype(np.float32)))
+
+
+def load_exported(path: str | os.PathLike) -> ExportedCompleter:
+    """Deserialises a file written by `save_exported`; the callable runs with jax only (no lipjax model code)."""
+    _need_flatbuffers()
+    blob = pathlib.Path(path).read_bytes()
+    try:
+        exported = jax.export.deserialize(bytearray(blob))
+    except Exception as exc:  # noqa: BLE001 - flatbuffer / version errors all mean "not a usable export file"
+        raise ValueError(f"{os.fspath(path)!r} is not a jax.export file this jax can read ({type(exc).__name__}: {exc})") from exc
+    return ExportedCompleter(exported)

@@ -1,0 +1,144 @@
+"""Depth maps <-> 3-D points: back-projection, PLY files, and LiDAR point clouds projected to sparse depth images.
+
+Camera frame (OpenCV): x right, y down, z forward (the optical axis), metres. Pixel (row v, column u) has its
+centre at image coordinates (u, v) and sees the ray through ((u - cx) / fx, (v - cy) / fy, 1); cx, cy are in
+the same pixel-index coordinates (lipjax.data.sample.Intrinsics). Depth is z, the distance along the optical
+axis (not the range along the ray), as in KITTI, NYU and TUM depth images.
+
+    points = backproject(depth_m, intrinsics)                         # (N, 3) for the valid pixels
+    write_ply("cloud.ply", *backproject_rgbd(depth_m, rgb, intrinsics))
+    sparse = project_lidar_to_depth(scan_xyz, intrinsics, T_cam_from_lidar, (H, W))   # the model's input
+"""
+from __future__ import annotations
+
+import os
+import pathlib
+
+import numpy as np
+
+from lipjax.data.sample import Intrinsics
+
+IntrinsicsLike = Intrinsics | np.ndarray
+
+
+def _intrinsics(intrinsics: IntrinsicsLike) -> Intrinsics:
+    if isinstance(intrinsics, Intrinsics):
+        return intrinsics
+    k = np.asarray(intrinsics, dtype=np.float64)
+    if k.shape == (4,):
+        return Intrinsics(*map(float, k))
+    if k.shape != (3, 3):
+        raise ValueError(f"intrinsics must be an Intrinsics, (fx, fy, cx, cy) or a 3x3 K, got shape {k.shape}")
+    return Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]))
+
+
+def _valid(depth: np.ndarray) -> np.ndarray:
+    return np.isfinite(depth) & (depth > 0)
+
+
+def backproject(depth_m: np.ndarray, intrinsics: IntrinsicsLike) -> np.ndarray:
+    """(N, 3) float32 camera-frame points (x right, y down, z forward, metres) of the valid pixels (depth > 0).
+
+    Points are in row-major pixel order. `intrinsics`: Intrinsics, (fx, fy, cx, cy) or a 3x3 K, in pixels.
+    """
+    depth = np.asarray(depth_m)
+    if depth.ndim != 2:
+        raise ValueError(f"depth must be (H, W) metres, got shape {depth.shape}")
+    k = _intrinsics(intrinsics)
+    v, u = np.nonzero(_valid(depth))
+    z = depth[v, u].astype(np.float64)
+    x = (u - k.cx) / k.fx * z
+    y = (v - k.cy) / k.fy * z
+    return np.stack([x, y, z], axis=1).astype(np.float32)
+
+
+def backproject_rgbd(depth_m: np.ndarray, rgb: np.ndarray, intrinsics: IntrinsicsLike) -> tuple[np.ndarray, np.ndarray]:
+    """(points (N, 3) float32 metres, colours (N, 3) uint8) of the valid pixels; see `backproject`."""
+    rgb = np.asarray(rgb)
+    depth = np.asarray(depth_m)
+    if rgb.shape != (*depth.shape, 3) or rgb.dtype != np.uint8:
+        raise ValueError(f"rgb must be uint8 {(*depth.shape, 3)} to match the depth, got {rgb.dtype} {rgb.shape}")
+    return backproject(depth, intrinsics), rgb[_valid(depth)]
+
+
+def write_ply(path: str | os.PathLike, points: np.ndarray, colors: np.ndarray | None = None,
+              binary: bool = True) -> None:
+    """Writes a PLY point cloud: float32 x y z (metres) and optional uchar red green blue per vertex.
+
+    Binary little-endian by default (compact; MeshLab, CloudCompare, Open3D, Blender read it), or ASCII.
+    """
+    points = np.asarray(points, dtype=np.float32)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points must be (N, 3), got shape {points.shape}")
+    if colors is not None:
+        colors = np.asarray(colors)
+        if colors.shape != points.shape:
+            raise ValueError(f"colors must be (N, 3) like the points {points.shape}, got {colors.shape}")
+        if colors.dtype != np.uint8:
+            raise ValueError(f"colors must be uint8 (0-255), got {colors.dtype}")
+    fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    if colors is not None:
+        fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+    header = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", "comment lipjax point cloud, metres",
+              f"element vertex {len(points)}"]
+    header += [f"property {'float' if t == '<f4' else 'uchar'} {name}" for name, t in fields]
+    header += ["end_header"]
+    vertices = np.empty(len(points), dtype=fields)
+    vertices["x"], vertices["y"], vertices["z"] = points.T
+    if colors is not None:
+        vertices["red"], vertices["green"], vertices["blue"] = colors.T
+    path = pathlib.Path(path)
+    with open(path, "wb") as f:
+        f.write(("\n".join(header) + "\n").encode("ascii"))
+        if binary:
+            f.write(vertices.tobytes())
+        else:
+            fmt = ["%.6g"] * 3 + (["%d"] * 3 if colors is not None else [])
+            np.savetxt(f, np.column_stack([points] + ([colors] if colors is not None else [])), fmt=fmt)
+
+
+def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike, T_cam_from_lidar: np.ndarray,
+                           image_size: tuple[int, int], min_depth_m: float = 1e-3) -> np.ndarray:
+    """Projects a LiDAR point cloud into a camera: the sparse depth image the model takes as input.
+
+    Args:
+      points_lidar: (N, 3) (or (N, >=3), extra columns such as intensity ignored) points in the LiDAR frame, metres.
+      intrinsics: the camera's Intrinsics, (fx, fy, cx, cy) or 3x3 K, pixels.
+      T_cam_from_lidar: (4, 4) rigid transform, p_cam = R p_lidar + t (KITTI: Tr_velo_to_cam; for a rectified
+        KITTI camera use R_rect @ Tr_velo_to_cam, and P_rect's fx fy cx cy). (3, 4) is accepted too.
+      image_size: (H, W) pixels.
+      min_depth_m: points with camera z below this (behind the camera or on it) are dropped.
+
+    Returns:
+      (H, W) float32 depth in metres (z in the camera frame), 0 where no point lands. A point lands in the pixel
+      whose centre is nearest its projection; when several land in one pixel the nearest (smallest z) is kept,
+      as a z-buffer would (a far point seen "through" a near surface is an occluded return). Points outside the
+      image are dropped.
+    """
+    points = np.asarray(points_lidar, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] < 3:
+        raise ValueError(f"points must be (N, 3) metres, got shape {points.shape}")
+    t = np.asarray(T_cam_from_lidar, dtype=np.float64)
+    if t.shape == (3, 4):
+        t = np.vstack([t, [0.0, 0.0, 0.0, 1.0]])
+    if t.shape != (4, 4) or not np.allclose(t[3], [0, 0, 0, 1]):
+        raise ValueError(f"T_cam_from_lidar must be a 4x4 rigid transform with last row [0 0 0 1], got {t.shape}")
+    h, w = (int(s) for s in image_size)
+    k = _intrinsics(intrinsics)
+    cam = points[:, :3] @ t[:3, :3].T + t[:3, 3]
+    z = cam[:, 2]
+    keep = np.isfinite(cam).all(axis=1) & (z >= min_depth_m)
+    cam, z = cam[keep], z[keep]
+    col = np.floor(k.fx * cam[:, 0] / z + k.cx + 0.5)
+    row = np.floor(k.fy * cam[:, 1] / z + k.cy + 0.5)
+    inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
+    pixel = row[inside].astype(np.int64) * w + col[inside].astype(np.int64)
+    z = z[inside]
+    depth = np.zeros(h * w, np.float32)
+    if pixel.size:
+        order = np.lexsort((z, pixel))  # by pixel, then nearest first
+        pixel, z = pixel[order], z[order]
+        first = np.ones(pixel.size, bool)
+        first[1:] = pixel[1:] != pixel[:-1]
+        depth[pixel[first]] = z[first]
+    return depth.reshape(h, w)

@@ -1,0 +1,214 @@
+"""Pictures of depth maps: colour maps with a fixed range, error maps, and side-by-side panels (paper Fig. 3).
+
+All functions return uint8 RGB images (H, W, 3) and never change global matplotlib state (no pyplot; the
+colour tables come from `matplotlib.colormaps`, figures are drawn on an Agg canvas).
+
+Conventions, fixed so that pictures of different frames and methods compare:
+  - `colorize_depth(depth_m, min_m=0, max_m=10, cmap="turbo")`: depth is clipped to [min_m, max_m] metres and
+    mapped linearly onto the colour map, near = low end (dark blue for turbo), far = high end (dark red).
+    The range never adapts to the image: pass min_m / max_m (e.g. 0-10 m indoors, 0-80 m outdoors).
+    Invalid pixels (depth <= 0, NaN, inf) are black.
+  - `error_map(pred, gt, valid, max_error_m=1)`: |pred - gt| in metres on "jet", dark blue (0 m) to dark red
+    (>= max_error_m), as the paper's error maps ("the value of the error increases from dark blue to dark red").
+    Pixels without valid ground truth are black.
+  - `colorize_sparse`: a sparse map with each sample drawn as a small disc, so 200 points stay visible.
+
+A Fig.-3-like figure (RGB | sparse input | GT | per method: prediction, error):
+
+    row = comparison_row(rgb, sparse, gt, valid, {"LIP+AD": pred}, max_m=10, max_error_m=0.5)
+    save_panel("fig3.png", [row], titles=comparison_titles(["LIP+AD"]))
+"""
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+
+import cv2
+import numpy as np
+
+DEFAULT_DEPTH_CMAP = "turbo"
+DEFAULT_ERROR_CMAP = "jet"
+INVALID_COLOR = (0, 0, 0)
+
+
+def _lut(cmap: str) -> np.ndarray:
+    """(256, 3) uint8 colour table of a matplotlib colour map."""
+    import matplotlib
+
+    try:
+        colormap = matplotlib.colormaps[cmap]
+    except KeyError:
+        raise ValueError(f"unknown colour map {cmap!r} (any matplotlib colour map name, e.g. 'turbo', 'magma')") from None
+    return np.round(colormap(np.linspace(0.0, 1.0, 256))[:, :3] * 255).astype(np.uint8)
+
+
+def _apply(values: np.ndarray, lo: float, hi: float, draw: np.ndarray, cmap: str) -> np.ndarray:
+    if not hi > lo:
+        raise ValueError(f"colour range must have max > min, got [{lo}, {hi}]")
+    values = np.asarray(values, dtype=np.float64)
+    t = np.clip((np.nan_to_num(values, nan=lo) - lo) / (hi - lo), 0.0, 1.0)
+    out = _lut(cmap)[np.round(t * 255).astype(np.intp)]
+    out[~draw] = INVALID_COLOR
+    return out
+
+
+def colorize_depth(depth_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
+                   cmap: str = DEFAULT_DEPTH_CMAP) -> np.ndarray:
+    """Depth (H, W) metres -> (H, W, 3) uint8 RGB over the fixed range [min_m, max_m]; invalid (<= 0) black."""
+    depth = np.asarray(depth_m)
+    if depth.ndim != 2:
+        raise ValueError(f"depth must be (H, W), got shape {depth.shape}")
+    valid = np.isfinite(depth) & (depth > 0)
+    return _apply(depth, min_m, max_m, valid, cmap)
+
+
+def colorize_sparse(sparse_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
+                    cmap: str = DEFAULT_DEPTH_CMAP, radius: int = 2) -> np.ndarray:
+    """A sparse depth map drawn with each sample enlarged to a (2 radius + 1)^2 square, for visibility.
+
+    Where enlarged samples overlap, the nearer one is drawn (as a z-buffer would). Colours as colorize_depth.
+    """
+    sparse = np.asarray(sparse_m, dtype=np.float32)
+    if radius > 0:
+        # Dilate 1/depth: max of inverse depth = the nearest sample; empty pixels (inf -> 0) never win.
+        with np.errstate(divide="ignore"):
+            inverse = np.where(sparse > 0, 1.0 / sparse, 0.0).astype(np.float32)
+        inverse = cv2.dilate(inverse, np.ones((2 * radius + 1, 2 * radius + 1), np.uint8))
+        with np.errstate(divide="ignore"):
+            sparse = np.where(inverse > 0, 1.0 / inverse, 0.0).astype(np.float32)
+    return colorize_depth(sparse, min_m, max_m, cmap)
+
+
+def error_map(pred_m: np.ndarray, gt_m: np.ndarray, valid: np.ndarray | None = None, max_error_m: float = 1.0,
+              cmap: str = DEFAULT_ERROR_CMAP) -> np.ndarray:
+    """|pred - gt| (H, W) metres -> (H, W, 3) uint8, dark blue (0) to dark red (>= max_error_m).
+
+    `valid` defaults to gt > 0; pixels outside it are black.
+    """
+    pred, gt = np.asarray(pred_m, np.float64), np.asarray(gt_m, np.float64)
+    if pred.shape != gt.shape or pred.ndim != 2:
+        raise ValueError(f"pred and gt must be (H, W) of the same size, got {pred.shape} and {gt.shape}")
+    valid = (gt > 0) if valid is None else np.asarray(valid, bool)
+    valid = valid & np.isfinite(gt) & np.isfinite(pred)
+    return _apply(np.abs(pred - gt), 0.0, max_error_m, valid, cmap)
+
+
+def _as_rgb(image: np.ndarray) -> np.ndarray:
+    image = np.asarray(image)
+    if image.ndim == 2:
+        image = np.repeat(image[..., None], 3, axis=2)
+    if image.ndim != 3 or image.shape[2] != 3 or image.dtype != np.uint8:
+        raise ValueError(f"panel images must be uint8 (H, W, 3) or (H, W), got {image.dtype} {image.shape}")
+    return image
+
+
+def panel(images: Sequence[np.ndarray] | Sequence[Sequence[np.ndarray]], titles: Sequence[str] | None = None,
+          pad: int = 4, background: int = 255) -> np.ndarray:
+    """Tiles images side by side (one row) or in a grid (a list of rows) into one uint8 RGB image.
+
+    Args:
+      images: uint8 (H, W, 3) or (H, W) images, or a list of such rows. Cells are as large as the largest image
+        of their column / row; smaller images are centred.
+      titles: optional column titles, written above the first row (cv2 Hershey font, black).
+      pad: pixels between cells and around the border.
+    """
+    if len(images) == 0:
+        raise ValueError("panel needs at least one image")
+    rows = [list(r) for r in images] if isinstance(images[0], (list, tuple)) else [list(images)]
+    rows = [[_as_rgb(im) for im in row] for row in rows]
+    ncols = max(len(r) for r in rows)
+    col_w = [max((r[c].shape[1] for r in rows if c < len(r)), default=0) for c in range(ncols)]
+    row_h = [max(im.shape[0] for im in r) for r in rows]
+    title_h = 0
+    font, scale, thick = cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1
+    if titles:
+        title_h = max(cv2.getTextSize(t, font, scale, thick)[0][1] for t in titles) + 8
+    height = pad + title_h + sum(h + pad for h in row_h)
+    width = pad + sum(w + pad for w in col_w)
+    out = np.full((height, width, 3), background, np.uint8)
+    x0s = np.cumsum([pad] + [w + pad for w in col_w[:-1]])
+    if titles:
+        for c, text in enumerate(list(titles)[:ncols]):
+            (tw, th), _ = cv2.getTextSize(text, font, scale, thick)
+            x = int(x0s[c] + max(0, (col_w[c] - tw) // 2))
+            cv2.putText(out, text, (x, pad + th + 2), font, scale, (0, 0, 0), thick, cv2.LINE_AA)
+    y = pad + title_h
+    for r, row in enumerate(rows):
+        for c, im in enumerate(row):
+            h, w = im.shape[:2]
+            yy, xx = y + (row_h[r] - h) // 2, int(x0s[c]) + (col_w[c] - w) // 2
+            out[yy:yy + h, xx:xx + w] = im
+        y += row_h[r] + pad
+    return out
+
+
+def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
+    """Writes a uint8 RGB (H, W, 3) or grey (H, W) image as PNG (cv2 wants BGR; converted here)."""
+    image = np.asarray(image)
+    if image.ndim == 3:
+        image = cv2.cvtColor(image, cv2.COLOR_RGB2BGR)
+    if not cv2.imwrite(os.fspath(path), image):
+        raise OSError(f"cannot write image {os.fspath(path)!r} (folder missing or unsupported extension?)")
+
+
+def comparison_titles(methods: Sequence[str]) -> list[str]:
+    """Column titles matching `comparison_row`."""
+    return ["RGB", "sparse input", "ground truth"] + [t for m in methods for t in (m, f"{m} error")]
+
+
+def comparison_row(rgb: np.ndarray, sparse_m: np.ndarray, gt_m: np.ndarray, valid: np.ndarray | None,
+                   predictions: Mapping[str, np.ndarray], min_m: float = 0.0, max_m: float = 10.0,
+                   max_error_m: float = 1.0, cmap: str = DEFAULT_DEPTH_CMAP) -> list[np.ndarray]:
+    """One row of a Fig.-3-like figure: RGB | sparse input | GT | for each method, prediction and error map.
+
+    Depths share one fixed colour range [min_m, max_m]; errors share [0, max_error_m]. Methods keep the mapping's
+    order. Use with `panel` or `save_panel`, titled by `comparison_titles(predictions)`.
+    """
+    valid = (np.asarray(gt_m) > 0) if valid is None else np.asarray(valid, bool)
+    gt_shown = np.where(valid, gt_m, 0)
+    row = [_as_rgb(rgb), colorize_sparse(sparse_m, min_m, max_m, cmap), colorize_depth(gt_shown, min_m, max_m, cmap)]
+    for pred in predictions.values():
+        row += [colorize_depth(pred, min_m, max_m, cmap), error_map(pred, gt_m, valid, max_error_m)]
+    return row
+
+
+def save_panel(path: str | os.PathLike, rows: Sequence[Sequence[np.ndarray]], titles: Sequence[str] | None = None,
+               row_labels: Sequence[str] | None = None, cell_inches: float = 2.0, dpi: int = 150,
+               colorbars: Sequence[tuple[str, float, float, str]] = ()) -> None:
+    """Writes a grid of images as a matplotlib figure (PNG / PDF / SVG by extension), with titles and colour bars.
+
+    Args:
+      rows: rows of uint8 images (see `panel`); all rows the same length.
+      titles: column titles; row_labels: one label per row (left side).
+      colorbars: (label, vmin, vmax, cmap) colour bars drawn under the grid, e.g. ("depth [m]", 0, 10, "turbo").
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+    from matplotlib.figure import Figure
+
+    rows = [[_as_rgb(im) for im in row] for row in rows]
+    nrows, ncols = len(rows), max(len(r) for r in rows)
+    h, w = rows[0][0].shape[:2]
+    extra = 0.6 if colorbars else 0.0
+    fig = Figure(figsize=(cell_inches * ncols, cell_inches * nrows * h / w + 0.4 + extra), dpi=dpi)
+    FigureCanvasAgg(fig)
+    grid = fig.add_gridspec(nrows + (1 if colorbars else 0), ncols,
+                            height_ratios=[1] * nrows + ([0.08] if colorbars else []), hspace=0.08, wspace=0.03)
+    for r, row in enumerate(rows):
+        for c in range(ncols):
+            ax = fig.add_subplot(grid[r, c])
+            ax.set_xticks([]), ax.set_yticks([])
+            if c < len(row):
+                ax.imshow(row[c], interpolation="nearest")
+            else:
+                ax.set_axis_off()
+            if r == 0 and titles and c < len(titles):
+                ax.set_title(titles[c], fontsize=8)
+            if c == 0 and row_labels and r < len(row_labels):
+                ax.set_ylabel(row_labels[r], fontsize=8)
+    for i, (label, vmin, vmax, cmap) in enumerate(colorbars):
+        span = max(1, ncols // max(1, len(colorbars)))
+        cax = fig.add_subplot(grid[nrows, i * span:(i + 1) * span])
+        fig.colorbar(ScalarMappable(Normalize(vmin, vmax), cmap), cax=cax, orientation="horizontal", label=label)
+    fig.savefig(os.fspath(path), bbox_inches="tight")

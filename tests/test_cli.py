@@ -1,0 +1,222 @@
+"""The `lipjax` command line, in-process (`lipjax.cli.main`), plus one subprocess run: outputs equal the library's,
+and every user error is one line "lipjax: error: ..." with exit status 1 and no traceback."""
+import os
+import pathlib
+import subprocess
+import sys
+
+import cv2
+import jax
+import numpy as np
+import pytest
+
+import lipjax
+from lipjax import cli, model_io, viz
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+
+H, W = 24, 32
+SCALE = 256.0
+CONFIG = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
+CACHE = pathlib.Path(__file__).resolve().parents[1] / ".jax_cache"  # the cache conftest set up
+
+
+@pytest.fixture(autouse=True)
+def _same_compilation_cache(monkeypatch):
+    # main() calls enable_compilation_cache(); point it at the cache the test session already uses.
+    monkeypatch.setenv("LIPJAX_CACHE_DIR", str(CACHE))
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory):
+    """(path stem of a saved tiny model, the same model as a Completer)."""
+    stem = tmp_path_factory.mktemp("model") / "tiny"
+    c = lipjax.Completer.random(CONFIG, seed=1)
+    model_io.save(stem, CONFIG, c.params)
+    return str(stem), lipjax.load_model(stem)
+
+
+def _frame(seed=0, h=H, w=W):
+    rng = np.random.default_rng(seed)
+    rgb = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    # Values on the PNG grid (k / 256) so the PNG and npy inputs hold the same metres.
+    sparse = np.where(rng.random((h, w)) < 0.1, np.round(rng.uniform(1, 5, (h, w)) * SCALE) / SCALE, 0)
+    sparse[0, 0] = 2.0
+    return rgb, sparse.astype(np.float32)
+
+
+def _write_frame(folder, rgb, sparse, rgb_name="rgb.png", depth_name="sparse.png"):
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(folder / rgb_name), rgb[..., ::-1])
+    if depth_name.endswith(".png"):
+        cv2.imwrite(str(folder / depth_name), np.round(sparse * SCALE).astype(np.uint16))
+    else:
+        np.save(folder / depth_name, sparse)
+    return str(folder / rgb_name), str(folder / depth_name)
+
+
+@pytest.fixture(scope="module")
+def frame(tmp_path_factory):
+    """Paths of one frame on disk: rgb png, 16-bit sparse png (scale 256), sparse npy (metres); and the arrays."""
+    folder = tmp_path_factory.mktemp("frame")
+    rgb, sparse = _frame()
+    rgb_path, png = _write_frame(folder, rgb, sparse)
+    _, npy = _write_frame(folder, rgb, sparse, depth_name="sparse.npy")
+    return {"rgb": rgb_path, "png": png, "npy": npy, "rgb_array": rgb, "sparse_array": sparse}
+
+
+def _complete(model, frame, out, *extra, depth="npy"):
+    args = ["complete", "--rgb", frame["rgb"], "--depth", frame[depth], "--model", model[0], "--out", str(out), "--quiet"]
+    if depth == "png":
+        args += ["--depth-scale", "256"]
+    return cli.main(args + list(extra))
+
+
+def test_png_in_png_out_same_scale_equals_library(model, frame, tmp_path):
+    assert _complete(model, frame, tmp_path / "out.png", depth="png") == 0
+    raw = cv2.imread(str(tmp_path / "out.png"), cv2.IMREAD_UNCHANGED)
+    assert raw.dtype == np.uint16 and raw.shape == (H, W)
+    expected = model[1](frame["rgb_array"], frame["sparse_array"])
+    np.testing.assert_array_equal(raw, np.round(expected * SCALE).astype(np.uint16))
+
+
+def test_npy_in_npy_out_metres_equals_library(model, frame, tmp_path):
+    assert _complete(model, frame, tmp_path / "out.npy") == 0
+    out = np.load(tmp_path / "out.npy")
+    assert out.dtype == np.float32 and out.shape == (H, W)
+    np.testing.assert_allclose(out, model[1](frame["rgb_array"], frame["sparse_array"]), rtol=1e-6)
+
+
+def test_color_png_and_ply_outputs(model, frame, tmp_path):
+    rc = _complete(model, frame, tmp_path / "out.color.png", "--color-range", "0", "6",
+                   "--ply", str(tmp_path / "cloud.ply"), "--intrinsics", "30", "30", "15.5", "11.5")
+    assert rc == 0
+    picture = cv2.imread(str(tmp_path / "out.color.png"), cv2.IMREAD_UNCHANGED)
+    assert picture.dtype == np.uint8 and picture.shape == (H, W, 3)
+    expected = model[1](frame["rgb_array"], frame["sparse_array"])
+    np.testing.assert_array_equal(picture[..., ::-1], viz.colorize_depth(expected, 0, 6))
+    header = (tmp_path / "cloud.ply").read_bytes().split(b"end_header\n")[0].decode()
+    assert f"element vertex {np.count_nonzero(expected > 0)}" in header and "binary_little_endian" in header
+
+
+def test_folder_batch_pairs_frames_by_trailing_number(model, tmp_path):
+    frames = {i: _frame(seed=i) for i in (2, 10)}
+    (tmp_path / "rgb").mkdir(), (tmp_path / "depth").mkdir()
+    for i, (rgb, sparse) in frames.items():  # BTS-style NYU names: stems differ, numbers match
+        cv2.imwrite(str(tmp_path / "rgb" / f"rgb_{i:05d}.png"), rgb[..., ::-1])
+        cv2.imwrite(str(tmp_path / "depth" / f"sync_depth_{i:05d}.png"), np.round(sparse * SCALE).astype(np.uint16))
+    rc = cli.main(["complete", "--rgb", str(tmp_path / "rgb"), "--depth", str(tmp_path / "depth"), "--depth-scale", "kitti",
+                   "--model", model[0], "--out", str(tmp_path / "out"), "--out-format", "npy"])
+    assert rc == 0
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["rgb_00002.npy", "rgb_00010.npy"]
+    for i, (rgb, sparse) in frames.items():
+        np.testing.assert_allclose(np.load(tmp_path / "out" / f"rgb_{i:05d}.npy"), model[1](rgb, sparse), rtol=1e-6)
+
+
+def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, tmp_path):
+    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16") == 0
+    out = np.load(tmp_path / "out.npy")
+    sparse = frame["sparse_array"]
+    assert out.shape == (H, W)
+    np.testing.assert_array_equal(out[sparse > 0], sparse[sparse > 0])
+    assert (out > 0).all()
+
+
+def test_reproject_sparse_keeps_values_and_the_nearest_sample():
+    sparse = np.zeros((8, 8), np.float32)
+    sparse[0, 0], sparse[0, 1] = 5.0, 3.0   # same 2x2 block: one output pixel, the nearer wins
+    sparse[7, 7] = 1.25
+    small = cli.reproject_sparse(sparse, (4, 4))
+    assert small[0, 0] == 3.0 and small[3, 3] == 1.25 and np.count_nonzero(small) == 2
+
+
+@pytest.mark.parametrize("case, message", [
+    ("unreadable_image", "Cannot read RGB image"),
+    ("size_mismatch", "aligned"),
+    ("png_without_scale", "--depth-scale"),
+    ("empty_sparse", "empty"),
+    ("unknown_model", "unknown model 'no-such-model'"),
+    ("too_many_iterations", "this model has 1 iterations"),
+    ("ply_without_intrinsics", "intrinsics"),
+])
+def test_user_errors_are_one_line_without_traceback(case, message, model, frame, tmp_path, capsys):
+    rgb, depth, model_arg, extra = frame["rgb"], frame["npy"], model[0], []
+    if case == "unreadable_image":
+        rgb = tmp_path / "broken.png"
+        rgb.write_bytes(b"this is not a png")
+    elif case == "size_mismatch":
+        depth = tmp_path / "small.npy"
+        np.save(depth, frame["sparse_array"][:-4])
+    elif case == "png_without_scale":
+        depth = frame["png"]
+    elif case == "empty_sparse":
+        depth = tmp_path / "empty.npy"
+        np.save(depth, np.zeros((H, W), np.float32))
+    elif case == "unknown_model":
+        model_arg = "no-such-model"
+    elif case == "too_many_iterations":
+        extra = ["--iterations", "2"]
+    elif case == "ply_without_intrinsics":
+        extra = ["--ply", str(tmp_path / "x.ply")]
+    rc = cli.main(["complete", "--rgb", str(rgb), "--depth", str(depth), "--model", model_arg,
+                   "--out", str(tmp_path / "out.npy"), *extra])
+    err = capsys.readouterr().err
+    assert rc == 1
+    assert len(err.strip().splitlines()) == 1 and err.startswith("lipjax: error: "), err
+    assert message in err and "Traceback" not in err
+    assert not (tmp_path / "out.npy").exists()
+
+
+def test_usage_error_returns_2(capsys):
+    assert cli.main(["complete", "--rgb", "a.png"]) == 2
+    assert "required" in capsys.readouterr().err
+
+
+def test_subprocess_error_has_no_traceback(tmp_path):
+    (tmp_path / "broken.jpg").write_bytes(b"\xff\xd8 truncated")
+    np.save(tmp_path / "s.npy", np.ones((4, 4), np.float32))
+    env = {**os.environ, "LIPJAX_CACHE_DIR": str(CACHE)}
+    env.pop("LIPJAX_DEBUG", None)
+    result = subprocess.run(
+        [sys.executable, "-m", "lipjax.cli", "complete", "--rgb", str(tmp_path / "broken.jpg"),
+         "--depth", str(tmp_path / "s.npy"), "--out", str(tmp_path / "o.npy")],
+        capture_output=True, text=True, timeout=300, env=env,
+    )
+    assert result.returncode == 1
+    assert result.stderr.startswith("lipjax: error: ") and "Traceback" not in result.stderr, result.stderr
+
+
+def test_models_command(capsys):
+    assert cli.main(["models"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in lipjax.available_models()) and out.strip()
+
+
+def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
+    rc = cli.main(["evaluate", "--model", model[0], "--data", "synthetic-indoor", "--size", str(H), str(W),
+                   "--limit", "1", "--sampler", "uniform:20", "--quiet", "--columns", "rmse_m,mae_m",
+                   "--json", str(tmp_path / "r.json")])
+    out = capsys.readouterr().out
+    assert rc == 0
+    assert "| method | rmse_m | mae_m |" in out and f"| {model[0]} |" in out
+    assert (tmp_path / "r.json").exists()
+
+
+def test_train_delegates_to_experiments_train(monkeypatch):
+    import experiments.train
+
+    seen = []
+    monkeypatch.setattr(experiments.train, "main", lambda argv: seen.append(argv))
+    assert cli.main(["train", "--config", "smoke", "--set", "g_steps=1"]) == 0
+    assert seen == [["--config", "smoke", "--set", "g_steps=1"]]
+
+
+def test_export_command_writes_a_deserializable_file(model, tmp_path):
+    pytest.importorskip("flatbuffers")
+    out = tmp_path / "m.stablehlo"
+    rc = cli.main(["export", "--model", model[0], "--height", "8", "--width", "16", "--batch", "2", "--out", str(out), "--quiet"])
+    assert rc == 0
+    exported = jax.export.deserialize(bytearray(out.read_bytes()))
+    assert [a.shape for a in exported.in_avals] == [(2, 8, 16, 3), (2, 8, 16)]
+    assert exported.out_avals[0].shape == (2, 8, 16)
