@@ -93,16 +93,15 @@ def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inp
     """The paper's Fig. 3 layout: per frame, RGB | sparse input | ground truth | each method's prediction and error."""
     from lipjax import viz
 
+    completers = {name: get_method(name) for name in methods}
     rows = []
     for sample, sparse in zip(samples, sparse_inputs):
-        row = [(sample.rgb, "RGB"), (viz.colorize_depth(sparse, 0.0, max_depth_m, dilate_px=2), "sparse input"),
-               (viz.colorize_depth(sample.depth, 0.0, max_depth_m), "ground truth")]
-        for name in methods:
-            pred = np.asarray(get_method(name)(sample.rgb, sparse))
-            row.append((viz.colorize_depth(pred, 0.0, max_depth_m), name))
-            row.append((viz.error_map(pred, sample.depth, sample.valid, max_error_m), f"{name} error"))
-        rows.append(row)
-    viz.save_grid(path, rows)
+        predictions = {name: np.asarray(c(sample.rgb, sparse)) for name, c in completers.items()}
+        rows.append(viz.comparison_row(sample.rgb, sparse, sample.depth, sample.valid, predictions,
+                                       0.0, max_depth_m, max_error_m))
+    viz.save_panel(path, rows, viz.comparison_titles(methods), row_labels=[s.id for s in samples],
+                   colorbars=[("depth [m]", 0.0, max_depth_m, viz.DEFAULT_DEPTH_CMAP),
+                              ("|error| [m]", 0.0, max_error_m, "jet")])
 
 
 def config_fields(config) -> dict[str, Any]:

@@ -92,9 +92,11 @@ def _positive_int(text: str) -> int:
 
 
 def load_completer(model: str | None, iterations: int | None = None):
-    """The Completer for --model (None: the shipped default, else an untrained model with a warning)."""
+    """The completer for --model: a lipjax.methods name (shipped model, saved model path, lip-wavelet-indoor,
+    nearest, ...) or None: the shipped default model, else an untrained model with a warning."""
     import lipjax
     from lipjax.inference import DEFAULT_MODEL
+    from lipjax.methods import get_method
 
     if model is None:
         if DEFAULT_MODEL in lipjax.available_models():
@@ -104,14 +106,18 @@ def load_completer(model: str | None, iterations: int | None = None):
                   "model, whose output is only a smooth fill of the samples; pass --model NAME|PATH")
             completer = lipjax.Completer.random()
     else:
-        completer = lipjax.load_model(model)
+        completer = get_method(model)
     if iterations is not None:
+        if not hasattr(completer, "with_iterations"):
+            raise CLIError(f"--iterations applies to LIP models; {model!r} is not one")
         completer = completer.with_iterations(iterations)
     return completer
 
 
 def _model_max_depth(completer) -> float:
-    return float(getattr(completer.config.prior, "max_depth_m", 10.0))
+    """The depth range a model was made for (10 m indoor, 85 m outdoor), 10 m when it does not say."""
+    prior = getattr(getattr(completer, "config", None), "prior", None)
+    return float(getattr(prior, "max_depth_m", 10.0))
 
 
 # ------------------------------------------------------------------------------------------- frame helpers
@@ -245,6 +251,8 @@ def _cmd_complete(args) -> int:
     intrinsics = _intrinsics_from_args(args)
     if args.ply and intrinsics is None:
         raise CLIError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
+    if args.color_range and not args.color_range[1] > args.color_range[0]:
+        raise CLIError(f"--color-range {args.color_range[0]:g} {args.color_range[1]:g}: MAX_M must be > MIN_M")
     for p in (rgb_path, depth_path):
         if not p.exists():
             raise CLIError(f"{p}: no such file or folder")
@@ -272,7 +280,7 @@ def _cmd_complete(args) -> int:
         from tqdm import tqdm
 
         progress = tqdm(jobs, desc=f"{PROG} complete", unit="frame", file=sys.stderr)
-    for (rgb_file, _, out_file, ply_file), (rgb, sparse) in zip(progress, frames):
+    for (_, _, out_file, ply_file), (rgb, sparse) in zip(progress, frames):
         if completer is None:
             completer = load_completer(args.model, args.iterations)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
@@ -286,19 +294,6 @@ def _cmd_complete(args) -> int:
     elif not args.quiet:
         print(f"wrote {len(jobs)} frame(s) to {out}", file=sys.stderr)
     return 0
-
-
-class _Protocolled:
-    """A data set seen through a named protocol (crop / resize)."""
-
-    def __init__(self, dataset, protocol):
-        self.dataset, self.protocol = dataset, protocol
-
-    def __len__(self):
-        return len(self.dataset)
-
-    def __getitem__(self, i):
-        return self.protocol(self.dataset[i])
 
 
 def _cmd_evaluate(args) -> int:
@@ -329,7 +324,7 @@ def _cmd_evaluate(args) -> int:
         dataset = FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics)
         range_from = protocol
     if protocol is not None:
-        dataset = _Protocolled(dataset, protocol)
+        dataset = protocols.ProtocolView(dataset, protocol)
     min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
     max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
     if max_depth is None:
@@ -338,7 +333,7 @@ def _cmd_evaluate(args) -> int:
     results = {}
     for model in args.model or [None]:
         completer = load_completer(model, args.iterations)
-        label = model if model is not None else completer.name
+        label = model if model is not None else ("untrained" if completer.name == "random" else completer.name)
         results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
                                   limit=args.limit, progress=not args.quiet, seed=args.seed)
     n = next(iter(results.values())).num_images
@@ -415,7 +410,8 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--depth", required=True, help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
     c.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output (default 256)")
-    c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path")
+    c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path "
+                   "(also any lipjax.methods name, e.g. ip_basic)")
     c.add_argument("--iterations", type=_positive_int, default=None, metavar="K", help="run the first K ADMM iterations")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, default=None, help="per-frame format with folder inputs")
@@ -430,7 +426,9 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=_cmd_complete)
 
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
-    e.add_argument("--model", action="append", default=None, help="repeat to compare models (default: the shipped default)")
+    e.add_argument("--model", "--method", dest="model", action="append", default=None,
+                   help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet-indoor, nearest, "
+                        "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
     e.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
     e.add_argument("--data", default="synthetic-indoor",
                    help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ (lipjax.data.folder layout)")

@@ -1,5 +1,6 @@
 """The `lipjax` command line, in-process (`lipjax.cli.main`), plus one subprocess run: outputs equal the library's,
 and every user error is one line "lipjax: error: ..." with exit status 1 and no traceback."""
+import json
 import os
 import pathlib
 import subprocess
@@ -194,13 +195,13 @@ def test_models_command(capsys):
 
 
 def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
-    rc = cli.main(["evaluate", "--model", model[0], "--data", "synthetic-indoor", "--size", str(H), str(W),
-                   "--limit", "1", "--sampler", "uniform:20", "--quiet", "--columns", "rmse_m,mae_m",
-                   "--json", str(tmp_path / "r.json")])
+    rc = cli.main(["evaluate", "--model", model[0], "--method", "nearest", "--data", "synthetic-indoor",
+                   "--size", str(H), str(W), "--limit", "1", "--sampler", "uniform:20", "--quiet",
+                   "--columns", "rmse_m,mae_m", "--json", str(tmp_path / "r.json")])
     out = capsys.readouterr().out
     assert rc == 0
-    assert "| method | rmse_m | mae_m |" in out and f"| {model[0]} |" in out
-    assert (tmp_path / "r.json").exists()
+    assert "| method | rmse_m | mae_m |" in out and f"| {model[0]} |" in out and "| nearest |" in out
+    assert set(json.loads((tmp_path / "r.json").read_text())) == {model[0], "nearest"}
 
 
 def test_train_delegates_to_experiments_train(monkeypatch):
