@@ -40,7 +40,7 @@ def main(argv=None) -> None:
         manager.close()
     else:
         state = train(config, workdir, progress=not args.no_progress)
-    max_depth = float(getattr(config.model.prior, "max_depth_m", 10.0))
+    max_depth = config.model.max_depth_m
     val = evaluate_params(config.model, state.g_params, validation_batches(config), max_depth)
     target = args.export or str(model_io.WEIGHTS_DIR / config.name)
     export(config, state, target, {"val_metrics": val, "val_sampler": config.data.val_sampler,

@@ -38,7 +38,6 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from lipjax import model as lip_model
 from lipjax.inference import Completer
 
 
@@ -52,7 +51,7 @@ def export_completer(completer: Completer, batch: int, height: int, width: int,
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
 
     def infer(rgb, sparse):
-        depth, _ = lip_model.apply(config, params, rgb, sparse)
+        depth, _ = config.apply(params, rgb, sparse)
         return jnp.maximum(depth, 0.0)
 
     specs = (jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),

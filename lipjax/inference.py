@@ -15,7 +15,6 @@ from typing import Any
 import jax
 import numpy as np
 
-from lipjax import model as lip_model
 from lipjax import model_io
 from lipjax.model import LIPConfig
 
@@ -62,7 +61,7 @@ def check_inputs(rgb: np.ndarray, sparse: np.ndarray) -> tuple[np.ndarray, np.nd
 @functools.lru_cache(maxsize=None)
 def _compiled(config: LIPConfig, return_trajectory: bool):
     def run(params, rgb, sparse):
-        return lip_model.apply(config, params, rgb, sparse, return_trajectory=return_trajectory)
+        return config.apply(params, rgb, sparse, return_trajectory=return_trajectory)
 
     return jax.jit(run)
 
@@ -71,7 +70,7 @@ def _compiled(config: LIPConfig, return_trajectory: bool):
 class Completer:
     """A LIP model with its parameters, callable on images. Build with `load_model` or `Completer.random`."""
 
-    config: LIPConfig
+    config: Any  # LIPConfig, or an end-to-end baseline's config (same init / apply interface)
     params: Any
     name: str = "lip"
     metadata: dict = dataclasses.field(default_factory=dict)
@@ -80,7 +79,7 @@ class Completer:
     def random(cls, config: LIPConfig | None = None, seed: int = 0) -> "Completer":
         """An untrained model (its network prox is the identity, so it returns the initial fill)."""
         config = config or LIPConfig()
-        return cls(config, lip_model.init(config, jax.random.key(seed)), name="random")
+        return cls(config, config.init(jax.random.key(seed)), name="random")
 
     def with_iterations(self, num_iterations: int) -> "Completer":
         """The same model run for fewer iterations (uses the first K of its per-iteration operators)."""
@@ -110,7 +109,7 @@ class Completer:
         return _compiled(self.config, True)(self.params, rgb, sparse)
 
     def parameter_count(self) -> int:
-        return lip_model.parameter_count(self.params["prox"])
+        return self.config.parameter_count(self.params)
 
 
 def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:

@@ -47,6 +47,23 @@ class LIPConfig:
     learn_rho: bool = True
     initial_estimate: InitialEstimate = "box_fill"
 
+    # The model interface shared with the end-to-end baselines (lipjax.baselines): a hashable config object with
+    # init / apply / parameter_count, so that training, inference, export and model files treat them alike.
+    def init(self, key: jax.Array) -> "Params":
+        return init(self, key)
+
+    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
+        return apply(self, params, rgb, sparse, weights, return_trajectory=return_trajectory)
+
+    def parameter_count(self, params) -> int:
+        """Learned network parameters (the prox networks of all iterations; rho excluded)."""
+        return parameter_count(params["prox"])
+
+    @property
+    def max_depth_m(self) -> float:
+        """Depth normalisation of the prior (metres); losses are computed in these units."""
+        return float(getattr(self.prior, "max_depth_m", 10.0))
+
     def __post_init__(self):
         if self.num_iterations < 1:
             raise ValueError(f"num_iterations must be >= 1, got {self.num_iterations}")

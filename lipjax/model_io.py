@@ -1,6 +1,6 @@
 """Saving and loading a trained LIP model: a config (JSON) and parameters (flax msgpack). No pickle.
 
-A model on disk is two files side by side: `<stem>.json` (the LIPConfig, with the prior's type named) and
+A model on disk is two files side by side: `<stem>.json` (the model config, with its type and its prior's type named) and
 `<stem>.msgpack` (the parameter pytree, `flax.serialization.msgpack_serialize`). Models shipped with the package
 live in `lipjax/weights/` and load by name, e.g. `load("lip-cnn-indoor")`.
 """
@@ -23,30 +23,52 @@ WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
 
 
 def _prior_types() -> dict[str, type]:
-    types = {"network": NetworkPrior}
-    try:  # the wavelet prior is optional at import time
-        from lipjax.priors.wavelet import WaveletPrior
+    from lipjax.priors.wavelet import WaveletPrior
 
-        types["wavelet"] = WaveletPrior
-    except ImportError:
-        pass
+    return {"network": NetworkPrior, "wavelet": WaveletPrior}
+
+
+def _model_types() -> dict[str, type]:
+    """Model config types by the name written in model files. End-to-end baselines register in
+    lipjax.baselines.networks (MODEL_TYPES): flat frozen dataclasses saved field by field."""
+    types: dict[str, type] = {"lip": LIPConfig}
+    try:
+        from lipjax.baselines.networks import MODEL_TYPES
+    except ImportError:  # the learned baselines are optional
+        MODEL_TYPES = {}
+    types.update(MODEL_TYPES)
     return types
 
 
-def config_to_dict(config: LIPConfig) -> dict:
-    kind = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
+def _tuples(d: dict) -> dict:
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in d.items()}
+
+
+def config_to_dict(config) -> dict:
+    """A JSON-able dict of a model config, with its type named (inverse: config_from_dict)."""
+    model_type = {cls: name for name, cls in _model_types().items()}.get(type(config))
+    if model_type is None:
+        raise ValueError(f"cannot save a model config of unregistered type {type(config).__name__}")
+    if not isinstance(config, LIPConfig):
+        return {"model_type": model_type, **dataclasses.asdict(config)}
+    prior_type = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
     fields = {f.name: getattr(config, f.name) for f in dataclasses.fields(config) if f.name != "prior"}
-    return {"prior_type": kind, "prior": dataclasses.asdict(config.prior), **fields}
+    return {"model_type": "lip", "prior_type": prior_type, "prior": dataclasses.asdict(config.prior), **fields}
 
 
-def config_from_dict(d: dict) -> LIPConfig:
+def config_from_dict(d: dict):
     d = dict(d)
-    types = _prior_types()
+    model_type = d.pop("model_type", "lip")
+    types = _model_types()
+    if model_type not in types:
+        raise ValueError(f"unknown model type {model_type!r} in model file; known: {sorted(types)}")
+    if model_type != "lip":
+        return types[model_type](**_tuples(d))
+    priors = _prior_types()
     kind = d.pop("prior_type")
-    if kind not in types:
-        raise ValueError(f"unknown prior type {kind!r} in model config; known: {sorted(types)}")
-    prior_fields = {k: tuple(v) if isinstance(v, list) else v for k, v in d.pop("prior").items()}
-    return LIPConfig(prior=types[kind](**prior_fields), **d)
+    if kind not in priors:
+        raise ValueError(f"unknown prior type {kind!r} in model file; known: {sorted(priors)}")
+    return LIPConfig(prior=priors[kind](**_tuples(d.pop("prior"))), **d)
 
 
 def _atomic_write(path: pathlib.Path, data: bytes) -> None:
@@ -61,7 +83,7 @@ def _atomic_write(path: pathlib.Path, data: bytes) -> None:
         raise
 
 
-def save(stem: str | os.PathLike, config: LIPConfig, params, metadata: dict | None = None) -> None:
+def save(stem: str | os.PathLike, config, params, metadata: dict | None = None) -> None:
     """Writes `<stem>.json` and `<stem>.msgpack`. `metadata` (training data, metrics, ...) goes into the JSON."""
     stem = pathlib.Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
@@ -90,7 +112,7 @@ def resolve(name_or_path: str | os.PathLike) -> pathlib.Path:
     )
 
 
-def load(name_or_path: str | os.PathLike) -> tuple[LIPConfig, dict, dict]:
+def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:
     """(config, params, metadata) of a shipped model name or a saved model path."""
     stem = resolve(name_or_path)
     doc = json.loads(stem.with_suffix(".json").read_text())

@@ -21,7 +21,6 @@ import numpy as np
 from jax.sharding import NamedSharding, PartitionSpec
 from tqdm.auto import tqdm
 
-from lipjax import model as lip_model
 from lipjax import model_io
 from lipjax.checkpoint import CheckpointManager
 from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_batch
@@ -85,7 +84,7 @@ _APPLY_CACHE: dict = {}
 
 def _jitted_apply(model_config):
     if model_config not in _APPLY_CACHE:
-        _APPLY_CACHE[model_config] = jax.jit(lambda p, rgb, sparse: lip_model.apply(model_config, p, rgb, sparse)[0])
+        _APPLY_CACHE[model_config] = jax.jit(lambda p, rgb, sparse: model_config.apply(p, rgb, sparse)[0])
     return _APPLY_CACHE[model_config]
 
 
@@ -138,7 +137,7 @@ def train(
     state = jax.device_put(state, replicated)
     steps = make_steps(config)
     val = validation_batches(config) if config.eval_every else []
-    max_depth = float(getattr(config.model.prior, "max_depth_m", 10.0))
+    max_depth = config.model.max_depth_m
 
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
     start = int(state.step)

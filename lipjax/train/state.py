@@ -8,7 +8,6 @@ import jax
 import jax.numpy as jnp
 import optax
 
-from lipjax import model as lip_model
 from lipjax.train.config import TrainConfig
 
 
@@ -41,7 +40,7 @@ def init_state(config: TrainConfig, g_params: Any | None = None) -> TrainState:
     key = jax.random.key(config.seed)
     g_key, d_key, rng = jax.random.split(key, 3)
     if g_params is None:
-        g_params = lip_model.init(config.model, g_key)
+        g_params = config.model.init(g_key)
     g_params = jax.tree_util.tree_map(jnp.asarray, g_params)
     d_params = config.discriminator.init(d_key) if config.adversarial else {}
     g_opt, d_opt = make_optimizers(config)

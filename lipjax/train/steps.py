@@ -14,7 +14,6 @@ import jax
 import jax.numpy as jnp
 import optax
 
-from lipjax import model as lip_model
 from lipjax.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
 from lipjax.train.config import TrainConfig
 from lipjax.train.state import TrainState, make_optimizers
@@ -38,11 +37,11 @@ def make_steps(config: TrainConfig) -> Steps:
     """The three jitted steps of a config; cached so that runs with the same config share compilations."""
     g_opt, d_opt = make_optimizers(config)
     model_config = config.model
-    scale = float(model_config.prior.max_depth_m) if hasattr(model_config.prior, "max_depth_m") else 1.0
+    scale = model_config.max_depth_m
     want_trajectory = bool(config.iteration_weights)
 
     def g_forward(g_params, batch):
-        out, traj = lip_model.apply(model_config, g_params, batch["rgb"], batch["sparse"], return_trajectory=want_trajectory)
+        out, traj = model_config.apply(g_params, batch["rgb"], batch["sparse"], return_trajectory=want_trajectory)
         return out, (traj.x if want_trajectory else None)
 
     def g_supervised(g_params, batch):
