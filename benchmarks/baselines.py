@@ -19,7 +19,7 @@ Data sets (each a Markdown table: rows = methods, columns = metrics with units, 
 
 Methods: the four classical completers (lipjax.baselines.classical) and LIP+Wavelet: the unrolled ADMM solver
 (lipjax.admm) with the wavelet soft-thresholding prox (lipjax.priors.wavelet), started from the box fill
-(lipjax.fill), with fixed, hand-picked settings (LIP_WAVELET below; not tuned on the test data).
+(lipjax.fill), as lipjax.baselines.lip_wavelet.LIPWavelet (settings chosen on val frames, see its docstring).
 
 Times are wall-clock ms per frame of the completer call on this machine (one warm-up call excluded); they
 depend on the machine and its load.
@@ -37,50 +37,13 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from lipjax.baselines.classical import BatchFnCompleter, classical_completers  # noqa: E402
+from lipjax.baselines.classical import classical_completers  # noqa: E402
+from lipjax.baselines.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
 
 INDOOR_RANGE_M = (0.0, 10.0)
 OUTDOOR_RANGE_M = (0.0, 80.0)
-
-# LIP+Wavelet settings: K ADMM iterations with a constant penalty rho, Haar with 4 levels and 2x2 cycle
-# spinning. The threshold tau = lambda / rho (metres) follows the depth scale (a few metres indoors, tens
-# outdoors): tau = tau_per_m_depth * (median sampled depth), so one setting serves both kinds of scene.
-# Chosen on 5 frames of each synthetic *val* setting among tau_per_m_depth in {0.003, 0.01, 0.03} x rho in
-# {0.1, 0.5}: the MAE differences are small (indoor 0.112-0.116 m, VLP-16 1.57-1.59 m, HDL-64 2.91-3.00 m, box fill
-# alone 0.126 / 1.62 / 2.92 m); rho = 0.1 keeps the samples closer (mae_vs_input_m 0.006 vs 0.02 m indoors).
-LIP_WAVELET = dict(iterations=20, rho=0.1, levels=4, shifts=2, tau_per_m_depth=0.01)
-
-
-def lip_wavelet_completer(iterations: int, rho: float, levels: int, shifts: int, tau_per_m_depth: float):
-    """LIP+Wavelet as a Completer: x_{k+1} = argmin data + rho/2||x - z + u||^2, z_{k+1} = wavelet prox."""
-    import jax
-    import jax.numpy as jnp
-
-    from lipjax.admm import unrolled_admm
-    from lipjax.fill import box_fill
-    from lipjax.priors.wavelet import WaveletPrior
-
-    prior = WaveletPrior(levels=levels, wavelet="haar", shifts=shifts)
-
-    @jax.jit
-    def run(rgb, sparse):
-        mask = (sparse > 0).astype(sparse.dtype)
-        # median of the sampled depths of the (single) image: the threshold's depth scale
-        scale = jnp.nanmedian(jnp.where(sparse > 0, sparse, jnp.nan))
-        params = {"threshold": tau_per_m_depth * scale}
-        x, _ = unrolled_admm(
-            prior.apply, params, sparse, mask, rgb, jnp.full((iterations,), rho, sparse.dtype),
-            z0=box_fill(sparse, mask), shared_params=True, unroll=False,
-        )
-        return x
-
-    return BatchFnCompleter("lip_wavelet", run)
-
-
-# ------------------------------------------------------------------------------------------- real frames
-
 
 def _rgb(path: str) -> np.ndarray:
     bgr = cv2.imread(path, cv2.IMREAD_COLOR)
@@ -185,8 +148,8 @@ def main(argv=None) -> None:
     wanted = args.methods.split(",")
     methods = [c for c in classical_completers() if c.name in wanted]
     if "lip_wavelet" in wanted:
-        methods.append(lip_wavelet_completer(**LIP_WAVELET))
-    print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIP_WAVELET}")
+        methods.append(LIPWavelet(name="lip_wavelet"))
+    print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIPWavelet()}")
 
     from lipjax.data import protocols
     from lipjax.data.sampling import LidarSampler, UniformSampler

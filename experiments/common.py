@@ -106,3 +106,33 @@ def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inp
 
 def config_fields(config) -> dict[str, Any]:
     return {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
+
+
+def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequence[float]], *, xlabel: str,
+              ylabel: str, title: str = "", logx: bool = False) -> None:
+    """One line per method (the paper's Fig. 4 style), written as PNG."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(5.5, 3.8), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for name, ys in series.items():
+        ax.plot(xs, ys, "o-", label=name, linestyle="--" if "wavelet" in name else "-")
+    if logx:
+        ax.set_xscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def synthetic_outdoor_test():
+    """The outdoor synthetic test split at the KITTI-like evaluation size (OUTDOOR_EVAL_SIZE)."""
+    from experiments.configs import OUTDOOR_DATA
+    from lipjax.data.synthetic import SyntheticDataset
+
+    return SyntheticDataset("outdoor", "test", height=OUTDOOR_DATA.height, width=OUTDOOR_DATA.width)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 
+from lipjax.baselines.networks import baseline_preset
 from lipjax.discriminator import Discriminator
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
@@ -53,6 +54,26 @@ LIP_AD_OUTDOOR = dataclasses.replace(
     init_from="lip-cnn-outdoor", discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M),
 )
 
+# End-to-end learned baselines (lipjax.baselines.networks; Ma et al. [2], U-Net [6], CSPN [7]): the same data,
+# samplers, batch size, loss, schedule and step budget as the LIP+CNN run of their scene, with a "small" preset of
+# about LIP small's parameter count over its 3 iterations (1.48 M):
+#     ma2018_*  SparseToDense, ResNet-34 basic blocks at 1/4 width, random init   1,553,369 parameters
+#     unet_*    UNet, base width 14, 4 levels                                      1,488,439 parameters
+#     cspn_*    CSPN, U-Net backbone of base width 14, 12 propagation steps        1,489,567 parameters
+BASELINE_PRESET = "small"
+
+
+def _baseline(lip: TrainConfig, name: str, model_type: str, max_depth_m: float) -> TrainConfig:
+    """The LIP+CNN run `lip` (data, batch size, loss, steps, schedule) with another model."""
+    return dataclasses.replace(lip, name=name, model=baseline_preset(model_type, BASELINE_PRESET, max_depth_m=max_depth_m))
+
+
+BASELINE_CONFIGS: dict[str, TrainConfig] = {
+    f"{key}_{scene}": _baseline(lip, f"{key}-{scene}", model_type, depth)
+    for key, model_type in (("ma2018", "sparse_to_dense"), ("unet", "unet"), ("cspn", "cspn"))
+    for scene, lip, depth in (("indoor", LIP_CNN_INDOOR, INDOOR_MAX_DEPTH_M), ("outdoor", LIP_CNN_OUTDOOR, OUTDOOR_MAX_DEPTH_M))
+}
+
 SMOKE = TrainConfig(
     name="smoke", model=LIPConfig(prior=network_preset("tiny"), num_iterations=2),
     data=DataConfig(kind="indoor", height=48, width=64, crop=(32, 48), val_images=4),
@@ -65,6 +86,7 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_ad_indoor": LIP_AD_INDOOR,
     "lip_ad_outdoor": LIP_AD_OUTDOOR,
     "smoke": SMOKE,
+    **BASELINE_CONFIGS,
 }
 
 

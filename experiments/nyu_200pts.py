@@ -39,7 +39,7 @@ class Config:
 VARIANTS = {
     "default": Config(),
     "full": Config(limit=None),
-    "smoke": Config(limit=2, methods=("nearest", "lip-wavelet-indoor"), figure_frames=1),
+    "smoke": Config(limit=2, methods=("nearest", "linear"), figure_frames=1),
 }
 
 

@@ -92,7 +92,7 @@ def _positive_int(text: str) -> int:
 
 
 def load_completer(model: str | None, iterations: int | None = None):
-    """The completer for --model: a lipjax.methods name (shipped model, saved model path, lip-wavelet-indoor,
+    """The completer for --model: a lipjax.methods name (shipped model, saved model path, lip-wavelet,
     nearest, ...) or None: the shipped default model, else an untrained model with a warning."""
     import lipjax
     from lipjax.inference import DEFAULT_MODEL
@@ -427,7 +427,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
-                   help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet-indoor, nearest, "
+                   help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
                         "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
     e.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
     e.add_argument("--data", default="synthetic-indoor",

@@ -25,28 +25,39 @@ def _window_sum(a: jax.Array, radius: int, axis: int) -> jax.Array:
     return jnp.take(c, hi, axis=axis) - jnp.take(c, lo, axis=axis)
 
 
-def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
-    """Dense fill of sparse depth.
+def box_fill_with_radius(y: jax.Array, weights: jax.Array) -> tuple[jax.Array, jax.Array]:
+    """Dense fill of sparse depth, and the window radius each pixel was filled from.
 
     Args:
       y: (..., H, W) sparse depth in metres, 0 where unmeasured.
       weights: (..., H, W) mask or confidence weights >= 0.
 
     Returns:
-      (..., H, W) dense depth in metres; 0 only where the whole image has no sample.
+      filled: (..., H, W) dense depth in metres; 0 only where the whole image has no sample.
+      radius: (..., H, W) float32, the half-width in pixels of the smallest window holding a sample (0 at a
+        sample itself): a cheap distance-to-the-nearest-measurement, i.e. how far the fill was extrapolated.
     """
     h, w = y.shape[-2:]
     wy = weights * y
-    filled = jnp.zeros_like(y)
-    found = jnp.zeros(y.shape, dtype=bool)
+    measured = weights > 1e-6
+    filled = jnp.where(measured, y, 0.0)
+    found = measured
+    radius_map = jnp.zeros(y.shape, jnp.float32)
     radius = 1
     while True:
         num = _window_sum(_window_sum(wy, radius, -2), radius, -1)
         den = _window_sum(_window_sum(weights, radius, -2), radius, -1)
         has = den > 1e-6
-        filled = jnp.where(found | ~has, filled, num / jnp.where(has, den, 1.0))
+        new = ~found & has
+        filled = jnp.where(new, num / jnp.where(has, den, 1.0), filled)
+        radius_map = jnp.where(new, float(radius), radius_map)
         found = found | has
         if radius >= max(h, w):
             break
         radius *= 2
-    return filled
+    return filled, radius_map
+
+
+def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
+    """Dense fill of sparse depth (see box_fill_with_radius): (..., H, W) metres in, (..., H, W) metres out."""
+    return box_fill_with_radius(y, weights)[0]

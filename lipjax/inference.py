@@ -83,9 +83,11 @@ class Completer:
 
     def with_iterations(self, num_iterations: int) -> "Completer":
         """The same model run for fewer iterations (uses the first K of its per-iteration operators)."""
+        if not hasattr(self.config, "num_iterations"):
+            raise ValueError(f"{self.name} is an end-to-end network, not an iterative LIP model: it has no iterations")
         if num_iterations == self.config.num_iterations:
             return self
-        if not 1 <= num_iterations <= self.config.num_iterations and not self.config.shared_prox:
+        if num_iterations < 1 or (num_iterations > self.config.num_iterations and not self.config.shared_prox):
             raise ValueError(f"this model has {self.config.num_iterations} iterations; got {num_iterations}")
         config = dataclasses.replace(self.config, num_iterations=num_iterations)
         params = dict(self.params)

@@ -19,11 +19,12 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
-from lipjax.fill import box_fill
+from lipjax.fill import box_fill_with_radius
 from lipjax.priors.network import NetworkPrior, network_preset
 
 Params = Any
 InitialEstimate = Literal["sparse", "box_fill"]
+Guidance = Literal["rgb", "rgb+mask"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -38,6 +39,9 @@ class LIPConfig:
       learn_rho: learn one rho_k per iteration (kept positive as exp(log_rho)); else rho_k = rho_init.
       initial_estimate: z_0. "sparse": z_0 = y (the paper). "box_fill": a multi-scale normalised box filter fill
         (lipjax.fill), so the first learned prox refines a dense map; measured pixels are kept by the x-update.
+      guidance: what the prox sees besides depth. "rgb": the image (the paper). "rgb+mask": also the sampling
+        mask and the fill's distance to the nearest sample, log2(1 + r) / 8 — with a dense z_0 the prox could
+        otherwise not tell measured depth from extrapolated depth.
     """
 
     prior: Any = dataclasses.field(default_factory=lambda: network_preset("small"))
@@ -46,6 +50,7 @@ class LIPConfig:
     rho_init: float = 0.1
     learn_rho: bool = True
     initial_estimate: InitialEstimate = "box_fill"
+    guidance: Guidance = "rgb+mask"
 
     # The model interface shared with the end-to-end baselines (lipjax.baselines): a hashable config object with
     # init / apply / parameter_count, so that training, inference, export and model files treat them alike.
@@ -69,6 +74,8 @@ class LIPConfig:
             raise ValueError(f"num_iterations must be >= 1, got {self.num_iterations}")
         if not self.rho_init > 0:
             raise ValueError(f"rho_init must be > 0, got {self.rho_init}")
+        if self.guidance not in ("rgb", "rgb+mask"):
+            raise ValueError(f"guidance must be 'rgb' or 'rgb+mask', got {self.guidance!r}")
         if self.initial_estimate not in ("sparse", "box_fill"):
             raise ValueError(f"initial_estimate must be 'sparse' or 'box_fill', got {self.initial_estimate!r}")
 
@@ -76,7 +83,8 @@ class LIPConfig:
 def init(config: LIPConfig, key: jax.Array) -> Params:
     """Random parameters: one prox set per iteration (independent keys), or one shared set."""
     # Parameter shapes never depend on the image size (fully convolutional priors); a small one keeps init cheap.
-    init_one = functools.partial(config.prior.init, image_shape=(64, 64))
+    channels = 5 if config.guidance == "rgb+mask" else 3
+    init_one = functools.partial(config.prior.init, image_shape=(64, 64), guidance_channels=channels)
     if config.shared_prox:
         prox = init_one(key)
     else:
@@ -123,14 +131,18 @@ def apply(
     sparse = sparse.astype(jnp.float32)
     if weights is None:
         weights = (sparse > 0).astype(jnp.float32)
-    rgb = _rgb_to_unit(rgb)
-    z0 = box_fill(sparse, weights) if config.initial_estimate == "box_fill" else sparse
+    guidance = _rgb_to_unit(rgb)
+    fill, radius = box_fill_with_radius(sparse, weights)
+    z0 = fill if config.initial_estimate == "box_fill" else sparse
+    if config.guidance == "rgb+mask":
+        extra = [(weights > 0).astype(jnp.float32), jnp.log2(1.0 + radius) / 8.0]
+        guidance = jnp.concatenate([guidance] + [e[..., None] for e in extra], axis=-1)
     return unrolled_admm(
         config.prior.apply,
         params["prox"],
         sparse,
         weights,
-        rgb,
+        guidance,
         rho_schedule(config, params),
         z0=z0,
         shared_params=config.shared_prox,

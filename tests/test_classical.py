@@ -154,9 +154,10 @@ def test_ipbasic_keeps_a_dense_smooth_map():
     yy, xx = np.mgrid[0:h, 0:w]
     dense = (3.0 + 0.02 * xx + 0.05 * yy).astype(np.float32)
     out = IPBasicFill()(_gray(h, w), dense)
-    # closing and the median keep a ramp; dilation of inverted depth shifts it by at most one kernel step
+    # Dense input -> radii (1, 1); dilating inverted depth moves each pixel to its nearest neighbour's depth,
+    # i.e. by about one pixel step of the ramp (0.05 m per row); median and bilateral (nearly) keep a ramp.
     interior = (slice(3, -3), slice(3, -3))
-    assert np.abs(out - dense)[interior].max() < 0.2
+    assert np.abs(out - dense)[interior].max() < 0.06
     const = IPBasicFill()(_gray(h, w), np.full((h, w), 4.0, np.float32))
     np.testing.assert_allclose(const, 4.0, atol=1e-4)
 

@@ -17,12 +17,13 @@ class Prior(Protocol):
 
     Shapes and units:
       v:   (B, H, W) float32 depth in metres (x_{k+1} + u_k).
-      rgb: (B, H, W, 3) float32 in [0, 1].
+      rgb: (B, H, W, C) float32 in [0, 1]: the RGB guidance image (C = 3), possibly with extra channels.
       returns z: (B, H, W) float32 depth in metres.
     """
 
-    def init(self, key: jax.Array, image_shape: tuple[int, int]) -> Params:
-        """Parameters of ONE iteration's operator for images of size image_shape = (H, W)."""
+    def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> Params:
+        """Parameters of ONE iteration's operator for images of size image_shape = (H, W) and a guidance image
+        of `guidance_channels` channels (RGB, possibly with extra channels such as the sampling mask)."""
         ...
 
     def apply(self, params: Params, v: jax.Array, rgb: jax.Array) -> jax.Array:

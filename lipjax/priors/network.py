@@ -77,7 +77,7 @@ class UpProjection(nn.Module):
 
 
 class ProxNet(nn.Module):
-    """G: (v (B,H,W) metres, rgb (B,H,W,3) in [0,1]) -> z (B,H,W) metres. See the module docstring."""
+    """G: (v (B,H,W) metres, guidance (B,H,W,C) in [0,1]: RGB, optionally + mask channels) -> z (B,H,W) metres."""
 
     stem_width: int
     bottleneck_widths: tuple[int, int, int]
@@ -118,10 +118,11 @@ class NetworkPrior:
     def module(self) -> ProxNet:
         return ProxNet(self.stem_width, tuple(self.bottleneck_widths), tuple(self.up_widths), self.max_depth_m)
 
-    def init(self, key: jax.Array, image_shape: tuple[int, int] = (64, 64)):
+    def init(self, key: jax.Array, image_shape: tuple[int, int] = (64, 64), guidance_channels: int = 3):
+        """Parameters for guidance images of `guidance_channels` channels (3 = RGB; the LIP model may add more)."""
         # Parameter shapes do not depend on the image size (fully convolutional); a small dummy keeps init cheap.
         v = jnp.zeros((1, *image_shape), jnp.float32)
-        rgb = jnp.zeros((1, *image_shape, 3), jnp.float32)
+        rgb = jnp.zeros((1, *image_shape, guidance_channels), jnp.float32)
         return self.module().init(key, v, rgb)["params"]
 
     def apply(self, params, v, rgb):

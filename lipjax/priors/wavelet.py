@@ -186,9 +186,9 @@ class WaveletPrior:
         if not 1 <= self.shifts <= 2**self.levels:
             raise ValueError(f"shifts must be in [1, 2^levels = {2**self.levels}], got {self.shifts}")
 
-    def init(self, key: jax.Array, image_shape: tuple[int, int]) -> dict[str, jax.Array]:
-        """{"threshold": tau in metres}; key and image_shape are unused (the prior has no random state)."""
-        del key, image_shape
+    def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> dict[str, jax.Array]:
+        """{"threshold": tau in metres}; the arguments are unused (the prior has no random state)."""
+        del key, image_shape, guidance_channels
         return {"threshold": jnp.asarray(self.threshold_m, dtype=jnp.float32)}
 
     def apply(self, params: dict[str, jax.Array], v: jax.Array, rgb: jax.Array | None = None) -> jax.Array:
