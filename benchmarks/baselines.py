@@ -37,7 +37,8 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from lipjax.baselines.classical import classical_completers  # noqa: E402
+from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
+from lipjax.methods import get_method  # noqa: E402
 from lipjax.baselines.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
@@ -141,14 +142,13 @@ def main(argv=None) -> None:
     ap.add_argument("--json", default=None, help="write all results (with per-image metrics) to this file")
     ap.add_argument("--skip-synthetic", action="store_true")
     ap.add_argument("--skip-real", action="store_true")
-    ap.add_argument("--methods", default="nearest,linear,ip_basic,colorization,lip_wavelet")
+    ap.add_argument("--methods", default="nearest,linear,ip_basic,colorization,lip-wavelet",
+                    help="comma-separated lipjax.methods names, e.g. add lip-cnn-indoor,lip-ad-indoor")
     ap.add_argument("--progress", action="store_true")
     args = ap.parse_args(argv)
 
     wanted = args.methods.split(",")
-    methods = [c for c in classical_completers() if c.name in wanted]
-    if "lip_wavelet" in wanted:
-        methods.append(LIPWavelet(name="lip_wavelet"))
+    methods = [get_method(name) for name in wanted]  # any lipjax.methods name: classical, lip-wavelet, learned models
     print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIPWavelet()}")
 
     from lipjax.data import protocols
@@ -159,7 +159,7 @@ def main(argv=None) -> None:
         from lipjax.data.synthetic import SyntheticDataset
 
         indoor = SyntheticDataset("indoor", "test", height=256, width=320)
-        outdoor = SyntheticDataset("outdoor", "test", height=256, width=320)
+        outdoor = SyntheticDataset("outdoor", "test", height=OUTDOOR_DATA.height, width=OUTDOOR_DATA.width)
         settings += [
             Setting("synthetic indoor test, 200 uniform points", indoor, UniformSampler(200), INDOOR_RANGE_M, True),
             Setting("synthetic outdoor test, HDL-64 pattern", outdoor, LidarSampler.hdl64(), OUTDOOR_RANGE_M, True),

@@ -286,3 +286,28 @@ def test_folder_errors(tmp_path):
     write_rgb(tmp_path / "rgb" / "b.png", pattern_rgb(1))
     with pytest.raises(DatasetError, match="no RGB/depth partner"):
         FolderDataset(tmp_path, intrinsics=Intrinsics(1, 1, 0, 0))
+
+
+def test_kitti_odometry_projects_the_scan_into_image_2(tmp_path):
+    from lipjax.data.kitti_odometry import KittiOdometry
+
+    seq = tmp_path / "sequences" / "00"
+    (seq / "image_2").mkdir(parents=True)
+    (seq / "velodyne").mkdir()
+    cv2.imwrite(str(seq / "image_2" / "000000.png"), np.zeros((10, 12, 3), np.uint8))
+    fx, cx, cy, baseline = 10.0, 6.0, 5.0, 0.5
+    p2 = [fx, 0, cx, fx * baseline, 0, fx, cy, 0, 0, 0, 1, 0]
+    # velodyne x forward, y left, z up -> camera x right, y down, z forward
+    tr = [0, -1, 0, 0, 0, 0, -1, 0, 1, 0, 0, 0]
+    (seq / "calib.txt").write_text("P0: " + " ".join(["0"] * 12) + "\nP2: " + " ".join(map(str, p2)) +
+                                   "\nTr: " + " ".join(map(str, tr)) + "\n")
+    # a point 4 m ahead, 0.5 m to the left of the LiDAR: camera-2 x = 0.5 baseline shift - 0.5 = 0 -> u = cx
+    points = np.array([[4.0, 0.5, 0.0, 0.3], [8.0, 0.5, 0.0, 0.1], [-3.0, 0.0, 0.0, 0.2]], np.float32)
+    points.tofile(seq / "velodyne" / "000000.bin")
+    ds = KittiOdometry(tmp_path)
+    sample = ds[0]
+    assert len(ds) == 1 and sample.id == "kitti_odometry/00/000000"
+    assert sample.depth[5, 6] == pytest.approx(4.0)  # the nearer of the two points on that ray wins; behind dropped
+    assert sample.valid.sum() == 1
+    with pytest.raises(ValueError, match="KITTI odometry root not found"):
+        KittiOdometry(tmp_path / "nope")

@@ -1,0 +1,100 @@
+"""KITTI odometry (raw Velodyne scans) for the paper's Table III: the scan projected into the left colour camera.
+
+Following Ma et al. (sparse-to-dense), the "ground truth" of a frame is its whole Velodyne scan projected into
+image_2 (z-buffered: the nearest point per pixel), and the input is exactly N of those points, drawn by
+`UniformSampler(N)` keyed by the frame id: so "200 points" means 200 real LiDAR returns.
+
+Layout (the odometry development kit's):
+
+    <root>/sequences/<SS>/image_2/<NNNNNN>.png
+    <root>/sequences/<SS>/velodyne/<NNNNNN>.bin     float32 (x, y, z, reflectance) per point, metres
+    <root>/sequences/<SS>/calib.txt                 "P2: 12 numbers" (3x4), "Tr: 12 numbers" (velodyne -> cam0)
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from lipjax.data.errors import dataset_error
+from lipjax.data.folder import natural_key, read_rgb
+from lipjax.data.sample import Intrinsics, Sample
+from lipjax.pointcloud import project_lidar_to_depth
+
+KITTI_ODOMETRY_LAYOUT = """\
+<root>/sequences/<SS>/image_2/<NNNNNN>.png
+<root>/sequences/<SS>/velodyne/<NNNNNN>.bin
+<root>/sequences/<SS>/calib.txt   (P2: ..., Tr: ...)"""
+KITTI_ODOMETRY_SOURCE = "KITTI odometry benchmark (colour images, Velodyne laser data, calibration files)"
+
+
+def read_odometry_calib(path: str | os.PathLike) -> tuple[Intrinsics, np.ndarray]:
+    """(intrinsics of image_2, (4, 4) T_cam2_from_velodyne) from a sequence's calib.txt."""
+    try:
+        rows = {}
+        for line in Path(path).read_text().splitlines():
+            key, sep, values = line.partition(":")
+            if sep:
+                rows[key.strip()] = np.array([float(v) for v in values.split()])
+        p2, tr = rows["P2"].reshape(3, 4), rows["Tr"].reshape(3, 4)
+    except (OSError, KeyError, ValueError) as e:
+        raise dataset_error(f"Cannot read KITTI odometry calibration ({e})", path, KITTI_ODOMETRY_LAYOUT,
+                            KITTI_ODOMETRY_SOURCE) from None
+    fx, fy, cx, cy = p2[0, 0], p2[1, 1], p2[0, 2], p2[1, 2]
+    # P2 = K [I | t]: image_2's offset from the rectified cam0 (a baseline along x, in metres).
+    t = np.array([(p2[0, 3] - cx * p2[2, 3]) / fx, (p2[1, 3] - cy * p2[2, 3]) / fy, p2[2, 3]])
+    cam2_from_velo = np.eye(4)
+    cam2_from_velo[:3] = tr
+    cam2_from_velo[:3, 3] += t
+    return Intrinsics(fx, fy, cx, cy), cam2_from_velo
+
+
+def read_velodyne_bin(path: str | os.PathLike) -> np.ndarray:
+    """(N, 3) float32 points in metres from a KITTI .bin scan (float32 x, y, z, reflectance per point)."""
+    raw = np.fromfile(os.fspath(path), dtype=np.float32)
+    if raw.size % 4:
+        raise dataset_error("Corrupt Velodyne scan (size not a multiple of 4 float32)", path, KITTI_ODOMETRY_LAYOUT,
+                            KITTI_ODOMETRY_SOURCE)
+    return raw.reshape(-1, 4)[:, :3]
+
+
+class KittiOdometry:
+    """Frames of KITTI odometry sequences as Samples whose depth is the projected scan (see module docstring).
+
+    Args:
+      root: the folder holding `sequences/`.
+      sequences: sequence names, e.g. ("00", "01"); default: every sequence with images and scans.
+    Sample.id = "kitti_odometry/<SS>/<NNNNNN>".
+    """
+
+    def __init__(self, root: str | os.PathLike, sequences: tuple[str, ...] | None = None):
+        seq_root = Path(root) / "sequences"
+        if not seq_root.is_dir():
+            raise dataset_error("KITTI odometry root not found", seq_root, KITTI_ODOMETRY_LAYOUT, KITTI_ODOMETRY_SOURCE)
+        names = sequences or sorted((p.name for p in seq_root.iterdir() if (p / "velodyne").is_dir()), key=natural_key)
+        self.frames: list[tuple[str, Path, Path]] = []
+        self.calib: dict[str, tuple[Intrinsics, np.ndarray]] = {}
+        for seq in names:
+            d = seq_root / seq
+            if not (d / "image_2").is_dir() or not (d / "velodyne").is_dir():
+                raise dataset_error(f"Sequence {seq!r} lacks image_2/ or velodyne/", d, KITTI_ODOMETRY_LAYOUT,
+                                    KITTI_ODOMETRY_SOURCE)
+            self.calib[seq] = read_odometry_calib(d / "calib.txt")
+            for scan in sorted((d / "velodyne").glob("*.bin"), key=lambda p: natural_key(p.stem)):
+                image = d / "image_2" / f"{scan.stem}.png"
+                if image.exists():
+                    self.frames.append((seq, image, scan))
+        if not self.frames:
+            raise dataset_error("No frames with both image_2/*.png and velodyne/*.bin under", seq_root,
+                                KITTI_ODOMETRY_LAYOUT, KITTI_ODOMETRY_SOURCE)
+
+    def __len__(self) -> int:
+        return len(self.frames)
+
+    def __getitem__(self, index: int) -> Sample:
+        seq, image_path, scan_path = self.frames[index]
+        rgb = read_rgb(image_path)
+        intrinsics, cam_from_velo = self.calib[seq]
+        depth = project_lidar_to_depth(read_velodyne_bin(scan_path), intrinsics, cam_from_velo, rgb.shape[:2])
+        return Sample.from_depth(rgb, depth, intrinsics, f"kitti_odometry/{seq}/{image_path.stem}")
