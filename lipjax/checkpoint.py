@@ -16,6 +16,14 @@ import numpy as np
 import orbax.checkpoint as ocp
 
 
+def to_host(a) -> np.ndarray:
+    """A numpy copy of a (replicated) array; in a multi-process run a replicated global array is not fully
+    addressable from one process, but each process holds a complete copy of it."""
+    if isinstance(a, jax.Array) and not a.is_fully_addressable:
+        return np.asarray(a.addressable_data(0))
+    return np.asarray(a)
+
+
 class CheckpointManager:
     """Saves and restores (state, metadata) pairs under `directory/<step>`."""
 
@@ -33,7 +41,7 @@ class CheckpointManager:
         return list(self._manager.all_steps())
 
     def save(self, step: int, state: Any, metadata: dict) -> None:
-        tree = jax.tree_util.tree_map(np.asarray, flax.serialization.to_state_dict(state))
+        tree = jax.tree_util.tree_map(to_host, flax.serialization.to_state_dict(state))
         self._manager.save(
             step, args=ocp.args.Composite(state=ocp.args.PyTreeSave(tree), meta=ocp.args.JsonSave(metadata)), force=True
         )

@@ -82,8 +82,8 @@ def test_interrupted_run_resumes_exactly(straight_run, tmp_path):
 def test_non_finite_loss_stops_and_keeps_last_good_checkpoint(tmp_path, monkeypatch):
     real_crop = loop.random_crop
 
-    def poisoned(batch, crop, seed, step):
-        batch = real_crop(batch, crop, seed, step)
+    def poisoned(batch, crop, seed, step, first_example=0):
+        batch = real_crop(batch, crop, seed, step, first_example)
         if step == 2:  # the third step sees a NaN in the ground truth
             batch = dataclasses.replace(batch, gt=np.full_like(batch.gt, np.nan))
         return batch
@@ -102,6 +102,31 @@ def test_random_crop_is_deterministic_per_step():
     assert a1.gt.shape == (2, 4, 5)
     np.testing.assert_array_equal(a1.gt, a2.gt)
     assert not np.array_equal(a1.gt, c.gt)
+
+
+# Multi-process: 2 processes on localhost, each with one CPU device, gloo collectives (tests/multiprocess_worker.py).
+MULTI_PROCESS_CONFIG = dataclasses.replace(CONFIG, batch_size=4, g_steps=2, d_steps=0, adv_steps=0, eval_every=0)
+
+
+def test_two_processes_match_one_process(tmp_path):
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    worker = os.path.join(os.path.dirname(__file__), "multiprocess_worker.py")
+    out = tmp_path / "params.npz"
+    procs = [subprocess.Popen([sys.executable, worker, str(i), str(port), str(tmp_path / "run"), str(out)],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) for i in range(2)]
+    logs = [p.communicate(timeout=600)[0] for p in procs]
+    assert all(p.returncode == 0 for p in procs), "\n".join(log[-2000:] for log in logs)
+    single = loop.train(MULTI_PROCESS_CONFIG, tmp_path / "single", progress=False)
+    with np.load(out) as multi:
+        got = [multi[f"arr_{i}"] for i in range(len(multi.files))]
+    want = [np.asarray(a) for a in jax.tree_util.tree_leaves(single.g_params)]
+    assert len(got) == len(want)
+    for a, b in zip(got, want):
+        np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-6)
 
 
 MULTI_DEVICE_SCRIPT = textwrap.dedent(

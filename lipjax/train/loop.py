@@ -22,7 +22,7 @@ from jax.sharding import NamedSharding, PartitionSpec
 from tqdm.auto import tqdm
 
 from lipjax import model_io
-from lipjax.checkpoint import CheckpointManager
+from lipjax.checkpoint import CheckpointManager, to_host
 from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_batch
 from lipjax.data.sample import Batch
 from lipjax.data.sampling import example_rng, sampler_from_spec
@@ -39,8 +39,12 @@ class TrainingDiverged(RuntimeError):
     """A non-finite loss: training stops and the last good checkpoint is kept."""
 
 
-def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int) -> Batch:
-    """Crops every example of a batch at a position drawn from (seed, step, example): resumable and deterministic."""
+def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int, first_example: int = 0) -> Batch:
+    """Crops every example of a batch at a position drawn from (seed, step, example): resumable and deterministic.
+
+    `first_example` is the index of this batch's first example in the global batch (a process's slice in
+    multi-process training), so that every example is cropped as it would be in a single-process run.
+    """
     if crop is None:
         return batch
     ch, cw = crop
@@ -49,9 +53,9 @@ def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int
         return batch
     if ch > h or cw > w:
         raise ValueError(f"crop {crop} is larger than the {h}x{w} images")
-    rng = example_rng(seed, f"crop/{step}")
-    tops = rng.integers(0, h - ch + 1, len(batch.gt))
-    lefts = rng.integers(0, w - cw + 1, len(batch.gt))
+    corners = [example_rng(seed, f"crop/{step}/{first_example + i}").integers(0, (h - ch + 1, w - cw + 1))
+               for i in range(len(batch.gt))]
+    tops, lefts = [c[0] for c in corners], [c[1] for c in corners]
 
     def cut(a):
         return np.stack([x[t : t + ch, l : l + cw] for x, t, l in zip(a, tops, lefts)])
@@ -134,13 +138,14 @@ def train(
             raise RuntimeError(f"checkpoint data position {meta.get('data_position')} != step {int(state.step)}")
         if is_main:
             print(f"[lipjax] resumed {config.name} from step {int(state.step)} in {manager.directory}")
+    start = int(state.step)
+    rng = jax.random.wrap_key_data(np.asarray(state.rng))
     state = jax.device_put(state, replicated)
     steps = make_steps(config)
     val = validation_batches(config) if config.eval_every else []
     max_depth = config.model.max_depth_m
 
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
-    start = int(state.step)
     d = config.data
     train_set = SyntheticDataset(d.kind, "train", height=d.height, width=d.width)
     batches = BatchIterator(train_set, config.batch_size, sampler_from_spec(d.train_sampler), seed=config.seed,
@@ -148,13 +153,12 @@ def train(
                             num_workers=d.num_workers)
     log = open(workdir / "metrics.jsonl", "a") if is_main else None
     bar = tqdm(total=end, initial=start, desc=config.name, disable=not (progress and is_main), dynamic_ncols=True)
-    rng = jax.random.wrap_key_data(np.asarray(state.rng))
     t_last, images = time.perf_counter(), 0
     step = start
     try:
         with prefetch(iter(batches), 2) as stream:
             for step in range(start, end):
-                batch = random_crop(next(stream), d.crop, config.seed, step)
+                batch = random_crop(next(stream), d.crop, config.seed, step, batches.local_batch_size * process_index)
                 phase = config.phase(step)
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
                 images += config.batch_size
@@ -176,11 +180,13 @@ def train(
                         log.flush()
                 if done % config.checkpoint_every == 0 or done == end:
                     manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name})
-                if val and (done % config.eval_every == 0 or done == end) and is_main:
+                if val and (done % config.eval_every == 0 or done == end):
+                    # every process evaluates (the parameters live on all of them); the main one logs
                     vm = evaluate_params(config.model, state.g_params, val, max_depth)
-                    log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
-                    log.flush()
-                    bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
+                    if log:
+                        log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
+                        log.flush()
+                        bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
                 bar.update(1)
     finally:
         bar.close()
@@ -193,6 +199,6 @@ def train(
 
 def export(config: TrainConfig, state: TrainState, path: str | os.PathLike, metadata: dict[str, Any] | None = None) -> None:
     """Saves the trained G as a loadable model (lipjax.load_model(path))."""
-    params = jax.tree_util.tree_map(np.asarray, state.g_params)
+    params = jax.tree_util.tree_map(to_host, state.g_params)
     meta = {"train_config": config.name, "steps": int(state.step), **(metadata or {})}
     model_io.save(path, config.model, params, meta)
