@@ -222,23 +222,10 @@ def _intrinsics_from_args(args):
 
 
 def _pair_folders(rgb_dir: Path, depth_dir: Path) -> list[tuple[Path, Path]]:
-    """(rgb, depth) paths paired by stem, else by trailing number (FolderDataset's rule), in natural order."""
-    from lipjax.data.folder import DEPTH_SUFFIXES, RGB_SUFFIXES, FolderDataset, _list, natural_key
+    """(rgb, depth) paths paired as FolderDataset pairs them (lipjax.data.folder.pair_frames)."""
+    from lipjax.data.folder import pair_frames
 
-    rgbs, depths = _list(rgb_dir, RGB_SUFFIXES), _list(depth_dir, DEPTH_SUFFIXES)
-    if not rgbs:
-        raise CLIError(f"{rgb_dir}: no RGB images (.png/.jpg/.jpeg) in this folder")
-    if not depths:
-        raise CLIError(f"{depth_dir}: no depth maps (.png/.npy) in this folder")
-    if not set(rgbs) & set(depths):
-        rgbs = FolderDataset._rekey_by_number(rgbs, rgb_dir)
-        depths = FolderDataset._rekey_by_number(depths, depth_dir)
-    unpaired = sorted(set(rgbs) ^ set(depths), key=natural_key)
-    if unpaired:
-        examples = [(rgbs.get(k) or depths.get(k)).name for k in unpaired[:3]]
-        raise CLIError(f"{len(unpaired)} frame(s) have no RGB/depth partner, e.g. {examples} "
-                       "(frames pair by file stem, or by the number the stem ends with)")
-    return [(rgbs[k], depths[k]) for k in sorted(rgbs, key=natural_key)]
+    return [(rgb, depth) for _, rgb, depth in pair_frames(rgb_dir, depth_dir)]
 
 
 # ------------------------------------------------------------------------------------------------ commands

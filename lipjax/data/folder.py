@@ -125,6 +125,36 @@ def _trailing_number(stem: str) -> str | None:
     return match.group(1) if match else None
 
 
+def pair_frames(rgb_dir: Path, depth_dir: Path) -> list[tuple[str, Path, Path]]:
+    """(key, rgb path, depth path) of every frame, in natural order. Frames pair by file stem; when no stem
+    matches, by the number the stem ends with. An RGB image without depth (or the reverse) is an error."""
+    rgbs, depths = _list(rgb_dir, RGB_SUFFIXES), _list(depth_dir, DEPTH_SUFFIXES)
+    if not rgbs:
+        raise dataset_error("No RGB images (.png/.jpg) found", rgb_dir, FOLDER_LAYOUT, FOLDER_SOURCE)
+    if not depths:
+        raise dataset_error("No depth maps (.png/.npy) found", depth_dir, FOLDER_LAYOUT, FOLDER_SOURCE)
+    if not set(rgbs) & set(depths):
+        rgbs = _rekey_by_number(rgbs)
+        depths = _rekey_by_number(depths)
+    missing = sorted(set(rgbs) ^ set(depths), key=natural_key)
+    if missing:
+        side = [str(rgbs.get(k) or depths.get(k)) for k in missing[:5]]
+        raise dataset_error(f"{len(missing)} frame(s) have no RGB/depth partner, e.g. {side}", rgb_dir.parent,
+                            FOLDER_LAYOUT)
+    return [(k, rgbs[k], depths[k]) for k in sorted(rgbs, key=natural_key)]
+
+
+def _rekey_by_number(files: dict[str, Path]) -> dict[str, Path]:
+    out: dict[str, Path] = {}
+    for stem, path in files.items():
+        number = _trailing_number(stem)
+        if number is None or number in out:
+            raise dataset_error("Cannot match frames: stems differ between rgb/ and depth/ and do not end in "
+                                "unique numbers, e.g.", path, FOLDER_LAYOUT)
+        out[number] = path
+    return out
+
+
 class FolderDataset:
     """A user's folder of RGB-D frames (layout in the module docstring), as Samples sorted by stem.
 
@@ -146,19 +176,10 @@ class FolderDataset:
         for directory in (rgb_dir, depth_dir):
             if not directory.is_dir():
                 raise dataset_error("Folder data set directory not found", directory, FOLDER_LAYOUT, FOLDER_SOURCE)
-        rgbs, depths = _list(rgb_dir, RGB_SUFFIXES), _list(depth_dir, DEPTH_SUFFIXES)
-        if not rgbs:
-            raise dataset_error("No RGB images (.png/.jpg) found", rgb_dir, FOLDER_LAYOUT, FOLDER_SOURCE)
-        if not set(rgbs) & set(depths):
-            rgbs = self._rekey_by_number(rgbs, rgb_dir)
-            depths = self._rekey_by_number(depths, depth_dir)
-        missing = sorted(set(rgbs) ^ set(depths), key=natural_key)
-        if missing:
-            side = [str(rgbs.get(k) or depths.get(k)) for k in missing[:5]]
-            raise dataset_error(f"{len(missing)} frame(s) have no RGB/depth partner, e.g. {side}", self.root, FOLDER_LAYOUT)
-        self.keys = sorted(rgbs, key=natural_key)
-        self.rgb_paths = [rgbs[k] for k in self.keys]
-        self.depth_paths = [depths[k] for k in self.keys]
+        frames = pair_frames(rgb_dir, depth_dir)
+        self.keys = [k for k, _, _ in frames]
+        self.rgb_paths = [r for _, r, _ in frames]
+        self.depth_paths = [d for _, _, d in frames]
         pngs = [p for p in self.depth_paths if p.suffix.lower() == ".png"]
         if pngs and depth_scale is None:
             raise dataset_error(
@@ -175,17 +196,6 @@ class FolderDataset:
                 self.root, FOLDER_LAYOUT,
             )
         self.id_prefix = id_prefix if id_prefix is not None else f"folder/{self.root.resolve().name}"
-
-    @staticmethod
-    def _rekey_by_number(files: dict[str, Path], directory: Path) -> dict[str, Path]:
-        out: dict[str, Path] = {}
-        for stem, path in files.items():
-            number = _trailing_number(stem)
-            if number is None or number in out:
-                raise dataset_error("Cannot match frames: stems differ between rgb/ and depth/ and do not end in "
-                                    "unique numbers, e.g.", path, FOLDER_LAYOUT)
-            out[number] = path
-        return out
 
     def __len__(self) -> int:
         return len(self.keys)
