@@ -77,6 +77,7 @@ def _atomic_write(path: pathlib.Path, data: bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
+        os.chmod(tmp, 0o644)  # mkstemp makes the file private; model files are meant to be shared
         os.replace(tmp, path)
     except BaseException:
         os.unlink(tmp)
