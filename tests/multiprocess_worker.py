@@ -1,6 +1,7 @@
 """One process of the 2-process training test (tests/test_train.py): run as
     python tests/multiprocess_worker.py PROCESS_ID PORT WORKDIR OUT.npz
-It trains MULTI_PROCESS_CONFIG with jax.distributed over CPU (gloo collectives) and, in process 0, saves G."""
+It trains the first MULTI_PROCESS_STEPS steps of the test CONFIG with jax.distributed over CPU (gloo collectives)
+and, in process 0, saves G."""
 import sys
 
 import jax
@@ -13,13 +14,13 @@ def main(process_id: int, port: int, workdir: str, out: str) -> None:
     import numpy as np
 
     sys.path.insert(0, __file__.rsplit("/", 1)[0])
-    from test_train import MULTI_PROCESS_CONFIG
+    from test_train import CONFIG, MULTI_PROCESS_STEPS
 
     from lipjax.checkpoint import to_host
     from lipjax.train import loop
 
     assert jax.process_count() == 2 and len(jax.devices()) == 2
-    state = loop.train(MULTI_PROCESS_CONFIG, workdir, progress=False)
+    state = loop.train(CONFIG, workdir, stop_at=MULTI_PROCESS_STEPS, progress=False)
     if process_id == 0:
         leaves = jax.tree_util.tree_leaves(state.g_params)
         np.savez(out, *[to_host(a) for a in leaves])

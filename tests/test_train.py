@@ -104,11 +104,13 @@ def test_random_crop_is_deterministic_per_step():
     assert not np.array_equal(a1.gt, c.gt)
 
 
-# Multi-process: 2 processes on localhost, each with one CPU device, gloo collectives (tests/multiprocess_worker.py).
-MULTI_PROCESS_CONFIG = dataclasses.replace(CONFIG, batch_size=4, g_steps=2, d_steps=0, adv_steps=0, eval_every=0)
+# Multi-process: 2 processes on localhost, each with one CPU device and half of every batch, gloo collectives
+# (tests/multiprocess_worker.py). They run the first MULTI_PROCESS_STEPS steps of CONFIG, compared with the
+# single-process straight run's checkpoint of that step (so no extra compilation in this process).
+MULTI_PROCESS_STEPS = 4
 
 
-def test_two_processes_match_one_process(tmp_path):
+def test_two_processes_match_one_process(straight_run, tmp_path):
     import socket
 
     with socket.socket() as s:
@@ -120,13 +122,17 @@ def test_two_processes_match_one_process(tmp_path):
                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) for i in range(2)]
     logs = [p.communicate(timeout=600)[0] for p in procs]
     assert all(p.returncode == 0 for p in procs), "\n".join(log[-2000:] for log in logs)
-    single = loop.train(MULTI_PROCESS_CONFIG, tmp_path / "single", progress=False)
+    workdir, _ = straight_run
+    single, _ = CheckpointManager(workdir / "checkpoints").restore(init_state(CONFIG), MULTI_PROCESS_STEPS)
     with np.load(out) as multi:
         got = [multi[f"arr_{i}"] for i in range(len(multi.files))]
     want = [np.asarray(a) for a in jax.tree_util.tree_leaves(single.g_params)]
     assert len(got) == len(want)
+    assert max(float(np.abs(b - i).max()) for b, i in zip(want, jax.tree_util.tree_leaves(init_state(CONFIG).g_params))) > 1e-4
     for a, b in zip(got, want):
-        np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-6)
+        # Different reduction orders give float-level differences, which Adam turns into update-sized ones on
+        # parameters whose gradient is ~0; 1e-5 is 1 % of one step (learning rate 1e-3).
+        np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5)
 
 
 MULTI_DEVICE_SCRIPT = textwrap.dedent(
