@@ -18,14 +18,19 @@ from lipjax.evaluate import EvalResult, evaluate, markdown_table
 from lipjax.methods import get_method
 
 
+def load_methods(methods: Sequence[str]) -> dict[str, Any]:
+    """Completers by name (lipjax.methods), loaded once and shared by the tables and figures of an experiment."""
+    return {name: get_method(name) for name in methods}
+
+
 def evaluate_methods(
-    methods: Sequence[str], dataset, sampler, *, min_depth_m: float, max_depth_m: float, limit: int | None,
-    seed: int = 0,
+    methods: Sequence[str] | dict[str, Any], dataset, sampler, *, min_depth_m: float, max_depth_m: float,
+    limit: int | None, seed: int = 0,
 ) -> dict[str, EvalResult]:
-    """Runs every named method on the same frames and the same sparse inputs."""
+    """Runs every method (names, or completers by name from load_methods) on the same frames and sparse inputs."""
+    completers = methods if isinstance(methods, dict) else load_methods(methods)
     results = {}
-    for name in methods:
-        completer = get_method(name)
+    for name, completer in completers.items():
         t0 = time.perf_counter()
         results[name] = evaluate(completer, dataset, sampler, min_depth_m=min_depth_m, max_depth_m=max_depth_m,
                                  limit=limit, seed=seed)
@@ -34,13 +39,9 @@ def evaluate_methods(
     return results
 
 
-def parameter_counts(methods: Sequence[str]) -> dict[str, int | None]:
+def parameter_counts(completers: dict[str, Any]) -> dict[str, int | None]:
     """Learned parameters per method (None for methods without learned parameters)."""
-    counts = {}
-    for name in methods:
-        m = get_method(name)
-        counts[name] = m.parameter_count() if hasattr(m, "parameter_count") and not name.startswith("lip-wavelet") else None
-    return counts
+    return {name: (c.parameter_count() if hasattr(c, "parameter_count") else None) for name, c in completers.items()}
 
 
 def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],
@@ -89,17 +90,16 @@ def _finite(x):
 
 
 def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inputs: Sequence[np.ndarray],
-                       methods: Sequence[str], max_depth_m: float, max_error_m: float) -> None:
+                       completers: dict[str, Any], max_depth_m: float, max_error_m: float) -> None:
     """The paper's Fig. 3 layout: per frame, RGB | sparse input | ground truth | each method's prediction and error."""
     from lipjax import viz
 
-    completers = {name: get_method(name) for name in methods}
     rows = []
     for sample, sparse in zip(samples, sparse_inputs):
         predictions = {name: np.asarray(c(sample.rgb, sparse)) for name, c in completers.items()}
         rows.append(viz.comparison_row(sample.rgb, sparse, sample.depth, sample.valid, predictions,
                                        0.0, max_depth_m, max_error_m))
-    viz.save_panel(path, rows, viz.comparison_titles(methods), row_labels=[s.id for s in samples],
+    viz.save_panel(path, rows, viz.comparison_titles(list(completers)), row_labels=[s.id for s in samples],
                    colorbars=[("depth [m]", 0.0, max_depth_m, viz.DEFAULT_DEPTH_CMAP),
                               ("|error| [m]", 0.0, max_error_m, "jet")])
 

@@ -15,7 +15,14 @@ import argparse
 import dataclasses
 import pathlib
 
-from experiments.common import evaluate_methods, parameter_counts, qualitative_figure, synthetic_outdoor_test, write_results
+from experiments.common import (
+    evaluate_methods,
+    load_methods,
+    parameter_counts,
+    qualitative_figure,
+    synthetic_outdoor_test,
+    write_results,
+)
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.methods import available_methods
@@ -62,9 +69,10 @@ def main(argv=None) -> dict:
         data_name = "embedded synthetic outdoor test split, 128x416 (lipjax.data.synthetic)"
         print("[lipjax] no --data-dir: KITTI is not on this machine, so this runs on the embedded synthetic outdoor "
               f"test split with a simulated {config.sampler} pattern.", flush=True)
-    results = evaluate_methods(methods, dataset, sampler, min_depth_m=protocol.min_depth_m,
+    completers = load_methods(methods)
+    results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
-    params = parameter_counts(methods)
+    params = parameter_counts(completers)
     n = next(iter(results.values())).num_images
     meta = {"title": f"Table II: {data_name}", "description": f"input {sampler_name}; {n} images; GT in "
             f"[{protocol.min_depth_m}, {protocol.max_depth_m}] m; RMSE/MAE in mm, iRMSE/iMAE in 1/km, params in M.",
@@ -73,7 +81,7 @@ def main(argv=None) -> dict:
     out = pathlib.Path(args.out)
     table = write_results(out, results, meta, COLUMNS, {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
     frames = [dataset[i] for i in range(2 if args.variant != "smoke" else 1)]
-    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], methods,
+    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers,
                        max_depth_m=protocol.max_depth_m, max_error_m=5.0)
     print(table)
     return {name: r.metrics for name, r in results.items()}

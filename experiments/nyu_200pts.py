@@ -15,7 +15,7 @@ import argparse
 import dataclasses
 import pathlib
 
-from experiments.common import evaluate_methods, parameter_counts, qualitative_figure, write_results
+from experiments.common import evaluate_methods, load_methods, parameter_counts, qualitative_figure, write_results
 from lipjax.data.protocols import ProtocolView, get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
@@ -77,9 +77,10 @@ def main(argv=None) -> dict:
         print("[lipjax] no --data-dir: NYU Depth v2 is not on this machine, so this runs on the embedded synthetic "
               "indoor test split (256x320). Pass --data-dir to use NYU.", flush=True)
     sampler = sampler_from_spec(f"uniform:{config.num_points}")
-    results = evaluate_methods(methods, dataset, sampler, min_depth_m=protocol.min_depth_m,
+    completers = load_methods(methods)
+    results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
-    params = parameter_counts(methods)
+    params = parameter_counts(completers)
     meta = {
         "title": f"Table I: {config.num_points} points, {data_name}",
         "description": f"protocol {protocol.name}; sampler uniform:{config.num_points} (exactly N valid pixels, keyed "
@@ -90,7 +91,7 @@ def main(argv=None) -> dict:
     }
     table = write_results(out, results, meta, COLUMNS, {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
     frames = [dataset[i] for i in range(min(config.figure_frames, len(dataset)))]
-    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], methods,
+    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers,
                        max_depth_m=protocol.max_depth_m, max_error_m=0.5)
     print(table)
     print(f"[lipjax] wrote {out}/results.json, table.md, figure.png")

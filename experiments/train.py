@@ -10,6 +10,7 @@ the training curves to <workdir>/curves.png.
 from __future__ import annotations
 
 import argparse
+import json
 import pathlib
 
 from experiments.configs import get_config
@@ -19,6 +20,15 @@ from lipjax.train.loop import evaluate_params, export, train, validation_batches
 from lipjax.train.state import init_state
 from lipjax.checkpoint import CheckpointManager
 from lipjax.utils import enable_compilation_cache
+
+
+def _final_validation(metrics_path: pathlib.Path, step: int) -> dict | None:
+    """The validation metrics the training loop logged at `step`, if any."""
+    if not metrics_path.exists():
+        return None
+    rows = [json.loads(line) for line in metrics_path.read_text().splitlines() if line.strip()]
+    found = [r for r in rows if r.get("split") == "val" and r["step"] == step]
+    return {k: v for k, v in found[-1].items() if k not in ("split", "step")} if found else None
 
 
 def main(argv=None) -> None:
@@ -40,8 +50,9 @@ def main(argv=None) -> None:
         manager.close()
     else:
         state = train(config, workdir, progress=not args.no_progress)
-    max_depth = config.model.max_depth_m
-    val = evaluate_params(config.model, state.g_params, validation_batches(config), max_depth)
+    val = _final_validation(workdir / "metrics.jsonl", int(state.step))
+    if val is None:  # not evaluated at this step by the loop (e.g. --export-only of an older checkpoint)
+        val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
     target = args.export or str(model_io.WEIGHTS_DIR / config.name)
     export(config, state, target, {"val_metrics": val, "val_sampler": config.data.val_sampler,
                                    "val_images": config.data.val_images, "data": config.data.kind})
