@@ -120,24 +120,22 @@ def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:
     return Completer(config, params, name=str(name_or_path), metadata=metadata)
 
 
-_default: Completer | None = None
+@functools.lru_cache(maxsize=1)
+def _default_model() -> Completer:
+    if DEFAULT_MODEL in model_io.available():
+        return load_model(DEFAULT_MODEL)
+    warnings.warn(f"no trained weights shipped ({DEFAULT_MODEL!r}); using an untrained model", stacklevel=3)
+    return Completer.random()
 
 
 def complete(rgb: np.ndarray, sparse: np.ndarray, model: Completer | str | None = None) -> np.ndarray:
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
-    `model` is a Completer, a shipped model name or a path; by default the shipped DEFAULT_MODEL, or, while no
-    weights are shipped, an untrained model (with a warning).
+    `model` is a Completer, a shipped model name or a path; by default the shipped DEFAULT_MODEL (loaded once),
+    or, while no weights are shipped, an untrained model (with a warning).
     """
-    global _default
     if isinstance(model, Completer):
         return model(rgb, sparse)
     if model is not None:
         return load_model(model)(rgb, sparse)
-    if _default is None:
-        if DEFAULT_MODEL in model_io.available():
-            _default = load_model(DEFAULT_MODEL)
-        else:
-            warnings.warn(f"no trained weights shipped ({DEFAULT_MODEL!r}); using an untrained model", stacklevel=2)
-            _default = Completer.random()
-    return _default(rgb, sparse)
+    return _default_model()(rgb, sparse)
