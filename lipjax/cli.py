@@ -116,8 +116,8 @@ def load_completer(model: str | None, iterations: int | None = None):
 
 def _model_max_depth(completer) -> float:
     """The depth range a model was made for (10 m indoor, 85 m outdoor), 10 m when it does not say."""
-    prior = getattr(getattr(completer, "config", None), "prior", None)
-    return float(getattr(prior, "max_depth_m", 10.0))
+    # every model config (LIP and the end-to-end baselines) states it; classical fills have no config
+    return float(getattr(getattr(completer, "config", None), "max_depth_m", 10.0))
 
 
 # ------------------------------------------------------------------------------------------- frame helpers

@@ -20,7 +20,7 @@ import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
 from lipjax.fill import box_fill_with_radius
-from lipjax.priors.network import NetworkPrior, network_preset
+from lipjax.priors.network import network_preset
 
 Params = Any
 InitialEstimate = Literal["sparse", "box_fill"]

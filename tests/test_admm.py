@@ -1,6 +1,5 @@
 """The unrolled solver: scan equals a Python loop, shared and per-iteration parameters, convergence with an exact
 prox to the closed-form solution of eq. 1, and gradients through the whole unroll."""
-import dataclasses
 
 import jax
 import jax.numpy as jnp

@@ -1,5 +1,4 @@
 """The public inference entry point: clear input errors, batching, compile-once, save/load round trip."""
-import dataclasses
 
 import numpy as np
 import pytest
