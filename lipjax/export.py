@@ -14,6 +14,9 @@ Choices:
   - The signature is fixed: rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) in metres with 0 = no sample ->
     dense depth float32 (B, H, W) metres, clamped at 0 like `Completer.__call__`. B, H, W are those given at
     export; another size needs another export. Any H, W works (the network pads to a multiple of 8 inside).
+  - Models whose initial estimate is computed on the host (`initial_estimate="linear"` or `"nearest"`: a
+    Delaunay triangulation is not a jit-able program) take a third input z0 float32 (B, H, W) metres, that
+    fill of `sparse`: `lipjax.model.host_initial_estimate(kind, sparse)` or any equivalent implementation.
   - No input checks run inside the exported program (a sparse map in millimetres or all zeros gives garbage,
     not an error); `load_exported`'s callable checks shapes and dtypes only. Use `lipjax.inference.check_inputs`
     where lipjax is installed.
@@ -50,12 +53,15 @@ def export_completer(completer: Completer, batch: int, height: int, width: int,
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
 
-    def infer(rgb, sparse):
-        depth, _ = config.apply(params, rgb, sparse)
+    specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
+             jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
+    if getattr(config, "needs_host_initial_estimate", False):
+        specs.append(jax.ShapeDtypeStruct((batch, height, width), jnp.float32))
+
+    def infer(rgb, sparse, *z0):
+        depth, _ = config.apply(params, rgb, sparse, **({"z0": z0[0]} if z0 else {}))
         return jnp.maximum(depth, 0.0)
 
-    specs = (jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
-             jax.ShapeDtypeStruct((batch, height, width), jnp.float32))
     return jax.export.export(jax.jit(infer), platforms=platforms)(*specs)
 
 
@@ -87,14 +93,25 @@ class ExportedCompleter:
         """(B, H, W) the model was exported for."""
         return tuple(int(d) for d in self.exported.in_avals[1].shape)  # type: ignore[return-value]
 
-    def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
+    @property
+    def needs_z0(self) -> bool:
+        """Whether the model takes a host-computed initial estimate z0 (B, H, W) metres as a third input."""
+        return len(self.exported.in_avals) == 3
+
+    def __call__(self, rgb: np.ndarray, sparse: np.ndarray, z0: np.ndarray | None = None) -> np.ndarray:
         rgb, sparse = np.asarray(rgb), np.asarray(sparse)
         b, h, w = self.input_shape
         if rgb.shape != (b, h, w, 3) or rgb.dtype != np.uint8:
             raise ValueError(f"this exported model takes rgb uint8 {(b, h, w, 3)}, got {rgb.dtype} {rgb.shape}")
         if sparse.shape != (b, h, w) or not np.issubdtype(sparse.dtype, np.floating):
             raise ValueError(f"this exported model takes sparse float32 metres {(b, h, w)}, got {sparse.dtype} {sparse.shape}")
-        return np.asarray(self.exported.call(rgb, sparse.astype(np.float32)))
+        args = [rgb, sparse.astype(np.float32)]
+        if self.needs_z0:
+            if z0 is None or np.shape(z0) != (b, h, w):
+                raise ValueError(f"this exported model also takes z0 float32 {(b, h, w)} metres, its initial fill of "
+                                 "sparse (lipjax.model.host_initial_estimate with the model's initial_estimate)")
+            args.append(np.asarray(z0, np.float32))
+        return np.asarray(self.exported.call(*args))
 
 
 def load_exported(path: str | os.PathLike) -> ExportedCompleter:

@@ -60,10 +60,15 @@ def check_inputs(rgb: np.ndarray, sparse: np.ndarray) -> tuple[np.ndarray, np.nd
 
 @functools.lru_cache(maxsize=None)
 def _compiled(config: LIPConfig, return_trajectory: bool):
-    def run(params, rgb, sparse):
-        return config.apply(params, rgb, sparse, return_trajectory=return_trajectory)
+    def run(params, rgb, sparse, extra):
+        return config.apply(params, rgb, sparse, return_trajectory=return_trajectory, **extra)
 
     return jax.jit(run)
+
+
+def _host_inputs(config, sparse: np.ndarray) -> dict:
+    """Inputs computed outside jit (a Delaunay initial estimate, ...); {} for models that need none."""
+    return config.host_inputs(sparse) if hasattr(config, "host_inputs") else {}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -101,14 +106,14 @@ class Completer:
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
         rgb, sparse, batched = check_inputs(rgb, sparse)
-        depth, _ = _compiled(self.config, False)(self.params, rgb, sparse)
+        depth, _ = _compiled(self.config, False)(self.params, rgb, sparse, _host_inputs(self.config, sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
         rgb, sparse, _ = check_inputs(rgb, sparse)
-        return _compiled(self.config, True)(self.params, rgb, sparse)
+        return _compiled(self.config, True)(self.params, rgb, sparse, _host_inputs(self.config, sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)

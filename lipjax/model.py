@@ -23,7 +23,11 @@ from lipjax.fill import box_fill_with_radius
 from lipjax.priors.network import network_preset
 
 Params = Any
-InitialEstimate = Literal["sparse", "box_fill"]
+InitialEstimate = Literal["sparse", "box_fill", "linear", "nearest"]
+# Initial estimates computed with numpy/scipy on the host (a Delaunay triangulation is not jit-able): the caller
+# passes them to `apply` as z0 (see `host_initial_estimate`); training computes them per batch in the loop.
+HOST_INITIAL_ESTIMATES = ("linear", "nearest")
+INITIAL_ESTIMATES = ("sparse", "box_fill") + HOST_INITIAL_ESTIMATES
 Guidance = Literal["rgb", "rgb+mask"]
 
 
@@ -38,7 +42,10 @@ class LIPConfig:
       rho_init: initial (or fixed) ADMM penalty, dimensionless, > 0; small rho trusts the measurements more.
       learn_rho: learn one rho_k per iteration (kept positive as exp(log_rho)); else rho_k = rho_init.
       initial_estimate: z_0. "sparse": z_0 = y (the paper). "box_fill": a multi-scale normalised box filter fill
-        (lipjax.fill), so the first learned prox refines a dense map; measured pixels are kept by the x-update.
+        (lipjax.fill, jit-able), so the first learned prox refines a dense map; measured pixels are kept by the
+        x-update. "linear" / "nearest": Delaunay piecewise-linear / nearest-sample fill, computed on the host
+        (`host_initial_estimate`) and passed to `apply` as z0. With the zero-initialised residual prox an
+        untrained model returns exactly this fill, so training starts from that classical baseline.
       guidance: what the prox sees besides depth. "rgb": the image (the paper). "rgb+mask": also the sampling
         mask and the fill's distance to the nearest sample, log2(1 + r) / 8 — with a dense z_0 the prox could
         otherwise not tell measured depth from extrapolated depth.
@@ -57,8 +64,19 @@ class LIPConfig:
     def init(self, key: jax.Array) -> "Params":
         return init(self, key)
 
-    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
-        return apply(self, params, rgb, sparse, weights, return_trajectory=return_trajectory)
+    def apply(self, params, rgb, sparse, weights=None, *, z0=None, return_trajectory: bool = False):
+        return apply(self, params, rgb, sparse, weights, z0=z0, return_trajectory=return_trajectory)
+
+    @property
+    def needs_host_initial_estimate(self) -> bool:
+        """Whether `apply` needs z0 from `host_initial_estimate` (not jit-able)."""
+        return self.initial_estimate in HOST_INITIAL_ESTIMATES
+
+    def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
+        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse depth: {"z0": ...} or {}."""
+        if not self.needs_host_initial_estimate:
+            return {}
+        return {"z0": host_initial_estimate(self.initial_estimate, sparse)}
 
     def parameter_count(self, params) -> int:
         """Learned network parameters (the prox networks of all iterations; rho excluded)."""
@@ -76,8 +94,8 @@ class LIPConfig:
             raise ValueError(f"rho_init must be > 0, got {self.rho_init}")
         if self.guidance not in ("rgb", "rgb+mask"):
             raise ValueError(f"guidance must be 'rgb' or 'rgb+mask', got {self.guidance!r}")
-        if self.initial_estimate not in ("sparse", "box_fill"):
-            raise ValueError(f"initial_estimate must be 'sparse' or 'box_fill', got {self.initial_estimate!r}")
+        if self.initial_estimate not in INITIAL_ESTIMATES:
+            raise ValueError(f"initial_estimate must be one of {INITIAL_ESTIMATES}, got {self.initial_estimate!r}")
 
 
 def init(config: LIPConfig, key: jax.Array) -> Params:
@@ -115,6 +133,7 @@ def apply(
     sparse: jax.Array,
     weights: jax.Array | None = None,
     *,
+    z0: jax.Array | None = None,
     return_trajectory: bool = False,
 ) -> tuple[jax.Array, Trajectory | None]:
     """Completes depth. Pure and jit-able (config static); no input checks here (see lipjax.inference).
@@ -123,6 +142,8 @@ def apply(
       rgb: (B, H, W, 3) uint8, or float in [0, 1].
       sparse: (B, H, W) float32 sparse depth in metres, 0 = no sample.
       weights: (B, H, W) per-pixel confidence >= 0 (noise-aware data term); defaults to the mask sparse > 0.
+      z0: (B, H, W) metres, the initial estimate, required when config.initial_estimate is computed on the host
+        ("linear", "nearest": `config.host_inputs(sparse)`), ignored otherwise.
       return_trajectory: also return every iteration's (x, z), each (K, B, H, W).
 
     Returns:
@@ -133,7 +154,15 @@ def apply(
         weights = (sparse > 0).astype(jnp.float32)
     guidance = _rgb_to_unit(rgb)
     fill, radius = box_fill_with_radius(sparse, weights)
-    z0 = fill if config.initial_estimate == "box_fill" else sparse
+    if config.needs_host_initial_estimate:
+        if z0 is None:
+            raise ValueError(f"initial_estimate={config.initial_estimate!r} is computed on the host: pass "
+                             "z0=config.host_inputs(sparse)['z0'] (lipjax.inference.Completer does this)")
+        if z0.shape != sparse.shape:
+            raise ValueError(f"z0 {z0.shape} must have the shape of sparse {sparse.shape}")
+        z0 = z0.astype(jnp.float32)
+    else:
+        z0 = fill if config.initial_estimate == "box_fill" else sparse
     if config.guidance == "rgb+mask":
         extra = [(weights > 0).astype(jnp.float32), jnp.log2(1.0 + radius) / 8.0]
         guidance = jnp.concatenate([guidance] + [e[..., None] for e in extra], axis=-1)
@@ -148,6 +177,23 @@ def apply(
         shared_params=config.shared_prox,
         return_trajectory=return_trajectory,
     )
+
+
+def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
+    """(B, H, W) float32 metres: the "linear" or "nearest" fill of each image of (B, H, W) sparse depth (0 = none).
+
+    Images without any sample get zeros (the model's input checks reject them before this in inference).
+    """
+    from lipjax.baselines.interpolate import linear_fill  # scipy-based; imported lazily (host only)
+    from lipjax.baselines.nearest import nearest_fill
+
+    fill = {"linear": linear_fill, "nearest": nearest_fill}[kind]
+    sparse = np.asarray(sparse, np.float32)
+    out = np.zeros(sparse.shape, np.float32)
+    for i, s in enumerate(sparse):
+        if (s > 0).any():
+            out[i] = fill(s)
+    return out
 
 
 def parameter_count(params: Params) -> int:

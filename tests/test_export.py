@@ -84,3 +84,19 @@ def test_wrong_input_shape_or_file_is_a_clear_error(exported_file, tmp_path):
     (tmp_path / "junk.stablehlo").write_bytes(b"not an export")
     with pytest.raises(ValueError, match="not a jax.export file"):
         load_exported(tmp_path / "junk.stablehlo")
+
+
+def test_host_initial_estimate_model_exports_with_a_z0_input(tmp_path):
+    """A model with a host-computed z_0 (Delaunay fill) exports with z0 as a third input, and needs it."""
+    import dataclasses
+
+    from lipjax.model import host_initial_estimate
+
+    c = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), num_iterations=1, initial_estimate="linear"))
+    run = load_exported(save_exported(export_completer(c, B, H, W), tmp_path / "lin.stablehlo"))
+    rgb, sparse = _inputs(1)
+    assert run.needs_z0
+    np.testing.assert_allclose(run(rgb, sparse, host_initial_estimate("linear", sparse)), c(rgb, sparse), atol=1e-5)
+    with pytest.raises(ValueError, match="z0"):
+        run(rgb, sparse)
+    assert not dataclasses.replace(c.config, initial_estimate="box_fill").needs_host_initial_estimate

@@ -87,3 +87,21 @@ def test_fewer_iterations_uses_the_first_operators(completer):
     assert trajectory.x.shape == (2, 1, 16, 20)
     with pytest.raises(ValueError):
         completer.with_iterations(5)
+
+
+@pytest.mark.parametrize("kind", ["linear", "nearest"])
+def test_host_initial_estimate_untrained_model_returns_that_fill(kind):
+    """With z_0 = a classical fill and the identity (untrained) prox, the model returns exactly that fill."""
+    from lipjax.baselines.interpolate import linear_fill
+    from lipjax.baselines.nearest import nearest_fill
+
+    config = LIPConfig(prior=network_preset("tiny"), num_iterations=1, initial_estimate=kind)
+    model = inference.Completer.random(config)
+    rng = np.random.default_rng(3)
+    gt = (1.0 + 3.0 * rng.random((2, 20, 28))).astype(np.float32)
+    sparse = np.where(rng.random(gt.shape) < 0.08, gt, 0.0).astype(np.float32)
+    rgb = rng.integers(0, 256, (2, 20, 28, 3), dtype=np.uint8)
+    expected = np.stack([{"linear": linear_fill, "nearest": nearest_fill}[kind](s) for s in sparse])
+    np.testing.assert_allclose(model(rgb, sparse), expected, atol=1e-5)
+    with pytest.raises(ValueError, match="computed on the host"):
+        config.apply(model.params, rgb, sparse)

@@ -265,7 +265,7 @@ def shard_batch(batch: Batch, mesh=None) -> dict[str, Any]:
       batch: this process's slice of the global batch (BatchIterator with process_index / process_count).
       mesh: a 1-D mesh with axis 'data' (default make_data_mesh()).
     Returns:
-      {"rgb", "sparse", "gt", "gt_valid"} -> jax.Array with the GLOBAL batch dim (local batch x processes),
+      {"rgb", "sparse", "gt", "gt_valid"[, "z0"]} -> jax.Array with the GLOBAL batch dim (local batch x processes),
       sharded with NamedSharding(mesh, PartitionSpec('data')); dtypes as in Batch.
     Raises:
       ValueError if the local batch does not split evenly over this process's devices.
@@ -278,7 +278,7 @@ def shard_batch(batch: Batch, mesh=None) -> dict[str, Any]:
         raise ValueError(f"shard_batch needs a 1-D mesh with axis {DATA_AXIS!r}, got axes {mesh.axis_names}")
     sharding = NamedSharding(mesh, PartitionSpec(DATA_AXIS))
     local_devices = [d for d in mesh.devices.flat if d.process_index == jax.process_index()]
-    arrays = {f.name: np.asarray(getattr(batch, f.name)) for f in dataclasses.fields(batch)}
+    arrays = {k: np.asarray(v) for k, v in batch.as_dict().items()}
     local_batch = arrays["rgb"].shape[0]
     if local_batch % len(local_devices):
         raise ValueError(

@@ -89,12 +89,16 @@ class Batch:
       sparse: (B, H, W) float32 sparse input depth in metres, 0 = no sample.
       gt: (B, H, W) float32 ground-truth depth in metres, 0 = invalid.
       gt_valid: (B, H, W) bool.
+      z0: (B, H, W) float32 metres or None: a host-computed initial estimate, for models that need one
+        (LIPConfig.host_inputs); added by the training loop after cropping.
     """
 
     rgb: np.ndarray
     sparse: np.ndarray
     gt: np.ndarray
     gt_valid: np.ndarray
+    z0: np.ndarray | None = None
 
     def as_dict(self) -> dict[str, np.ndarray]:
-        return dataclasses.asdict(self)
+        """The arrays of the batch (z0 only when present)."""
+        return {k: v for k, v in dataclasses.asdict(self).items() if v is not None}

@@ -9,6 +9,7 @@ lipjax.data.pipeline), recorded in each checkpoint's metadata and checked on res
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -63,13 +64,19 @@ def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int
     return Batch(rgb=cut(batch.rgb), sparse=cut(batch.sparse), gt=cut(batch.gt), gt_valid=cut(batch.gt_valid))
 
 
+def with_host_inputs(model_config, batch: Batch) -> Batch:
+    """Adds the host-computed initial estimate z0 to a (cropped) batch for models that need one."""
+    extra = model_config.host_inputs(batch.sparse) if hasattr(model_config, "host_inputs") else {}
+    return dataclasses.replace(batch, **extra) if extra else batch
+
+
 def validation_batches(config: TrainConfig) -> list[Batch]:
     """The fixed validation set: the first `val_images` synthetic val frames at full size, with val_sampler."""
     d = config.data
     dataset = SyntheticDataset(d.kind, "val", size=d.val_images, height=d.height, width=d.width)
     it = BatchIterator(dataset, min(EVAL_BATCH_SIZE, len(dataset)), sampler_from_spec(d.val_sampler), shuffle=False,
                        drop_last=False, num_epochs=1)
-    return list(it)
+    return [with_host_inputs(config.model, b) for b in it]
 
 
 def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: float) -> dict[str, float]:
@@ -77,7 +84,7 @@ def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: flo
     apply = _jitted_apply(model_config)
     agg = MetricAggregator()
     for b in batches:
-        pred = np.asarray(apply(params, b.rgb, b.sparse))
+        pred = np.asarray(apply(params, b.rgb, b.sparse, b.z0))
         for i in range(len(pred)):
             agg.add(compute_metrics(pred[i], b.gt[i], b.gt_valid[i], b.sparse[i], min_depth_m=0.0, max_depth_m=max_depth_m))
     return agg.means()
@@ -88,7 +95,11 @@ _APPLY_CACHE: dict = {}
 
 def _jitted_apply(model_config):
     if model_config not in _APPLY_CACHE:
-        _APPLY_CACHE[model_config] = jax.jit(lambda p, rgb, sparse: model_config.apply(p, rgb, sparse)[0])
+        def run(params, rgb, sparse, z0):
+            extra = {} if z0 is None else {"z0": z0}
+            return model_config.apply(params, rgb, sparse, **extra)[0]
+
+        _APPLY_CACHE[model_config] = jax.jit(run)
     return _APPLY_CACHE[model_config]
 
 
@@ -159,6 +170,7 @@ def train(
         with prefetch(iter(batches), 2) as stream:
             for step in range(start, end):
                 batch = random_crop(next(stream), d.crop, config.seed, step, batches.local_batch_size * process_index)
+                batch = with_host_inputs(config.model, batch)
                 phase = config.phase(step)
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
                 images += config.batch_size

@@ -1,7 +1,7 @@
 """jit-compiled, pure train steps: `step(state, batch, key) -> (state, metrics)`.
 
 `batch` is a dict of arrays: rgb (B,H,W,3) uint8, sparse (B,H,W) float32 m, gt (B,H,W) float32 m,
-gt_valid (B,H,W) bool. Sharded over a 'data' mesh axis, the same jitted step runs data-parallel: XLA inserts the
+gt_valid (B,H,W) bool, and z0 (B,H,W) float32 m for models with a host-computed initial estimate. Sharded over a 'data' mesh axis, the same jitted step runs data-parallel: XLA inserts the
 gradient all-reduce, parameters stay replicated.
 """
 from __future__ import annotations
@@ -41,7 +41,9 @@ def make_steps(config: TrainConfig) -> Steps:
     want_trajectory = bool(config.iteration_weights)
 
     def g_forward(g_params, batch):
-        out, traj = model_config.apply(g_params, batch["rgb"], batch["sparse"], return_trajectory=want_trajectory)
+        extra = {"z0": batch["z0"]} if "z0" in batch else {}  # host-computed initial estimate (LIPConfig.host_inputs)
+        out, traj = model_config.apply(g_params, batch["rgb"], batch["sparse"], return_trajectory=want_trajectory,
+                                       **extra)
         return out, (traj.x if want_trajectory else None)
 
     def g_supervised(g_params, batch):
