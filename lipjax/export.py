@@ -18,7 +18,7 @@ Choices:
     Delaunay triangulation is not a jit-able program) take a third input z0 float32 (B, H, W) metres, that
     fill of `sparse`: `lipjax.model.host_initial_estimate(kind, sparse)` or any equivalent implementation.
   - No input checks run inside the exported program (a sparse map in millimetres or all zeros gives garbage,
-    not an error); `load_exported`'s callable checks shapes and dtypes only. Use `lipjax.inference.check_inputs`
+    not an error); `load_exported`'s callable checks shapes and dtypes only. Use `lipjax.inputs.check_inputs`
     where lipjax is installed.
   - Platforms: by default the platform of the exporting machine (`jax.export.default_export_platform()`);
     pass `platforms=("cpu", "cuda")` for a file that runs on either.

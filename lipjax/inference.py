@@ -1,4 +1,4 @@
-"""The jit-compiled inference entry point: `Completer` (a model with its parameters) and input checks.
+"""The jit-compiled inference entry point: `Completer` (a model with its parameters); inputs checked by lipjax.inputs.
 
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
 same size, and returns dense depth in metres. The solver is compiled once per (config, input shape): jit caches
@@ -16,46 +16,10 @@ import jax
 import numpy as np
 
 from lipjax import model_io
+from lipjax.inputs import InputError, check_inputs  # noqa: F401  (re-exported: lipjax.InputError)
 from lipjax.model import LIPConfig
 
 DEFAULT_MODEL = "lip-ad-indoor"
-
-
-class InputError(ValueError):
-    """Bad input to the completer: the message names the problem."""
-
-
-def check_inputs(rgb: np.ndarray, sparse: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
-    """Validates and batches inputs. Returns (rgb (B,H,W,3) uint8|float32, sparse (B,H,W) float32, was_batched)."""
-    rgb = np.asarray(rgb)
-    sparse = np.asarray(sparse)
-    batched = rgb.ndim == 4
-    if rgb.ndim not in (3, 4) or rgb.shape[-1] != 3:
-        raise InputError(f"rgb must be (H, W, 3) or (B, H, W, 3), got shape {rgb.shape}")
-    if rgb.dtype != np.uint8 and not np.issubdtype(rgb.dtype, np.floating):
-        raise InputError(f"rgb must be uint8 (0-255) or float in [0, 1], got dtype {rgb.dtype}")
-    if np.issubdtype(rgb.dtype, np.floating) and (not np.isfinite(rgb).all() or rgb.min() < 0 or rgb.max() > 1):
-        raise InputError("float rgb must be finite and in [0, 1]; pass uint8 for 0-255 images")
-    if sparse.ndim != rgb.ndim - 1:
-        raise InputError(f"sparse depth must be (H, W) or (B, H, W) to match rgb {rgb.shape}, got {sparse.shape}")
-    if sparse.shape != rgb.shape[:-1]:
-        raise InputError(f"sparse depth {sparse.shape} and rgb {rgb.shape[:-1]} differ in size; align them first")
-    if not np.issubdtype(sparse.dtype, np.floating):
-        raise InputError(f"sparse depth must be float metres, got dtype {sparse.dtype} (raw PNG? divide by its scale)")
-    if not np.isfinite(sparse).all():
-        raise InputError("sparse depth contains NaN or inf; use 0 for missing samples")
-    if (sparse < 0).any():
-        raise InputError("sparse depth contains negative values; depth is in metres with 0 = missing")
-    if not batched:
-        rgb, sparse = rgb[None], sparse[None]
-    empty = [i for i in range(sparse.shape[0]) if not (sparse[i] > 0).any()]
-    if empty:
-        raise InputError(f"sparse depth has no samples (all zeros) in image(s) {empty}; nothing to complete from")
-    if sparse.max() > 1000:
-        raise InputError(f"sparse depth reaches {sparse.max():.0f}: that is not metres (millimetres? divide by 1000)")
-    if np.issubdtype(rgb.dtype, np.floating):
-        rgb = rgb.astype(np.float32)
-    return rgb, sparse.astype(np.float32), batched
 
 
 @functools.lru_cache(maxsize=None)

@@ -14,10 +14,11 @@ baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
 from __future__ import annotations
 
 from lipjax.baselines.colorization import ColorizationFill, colorization_fill
-from lipjax.baselines.completer import BatchFnCompleter, Completer, check_inputs
+from lipjax.baselines.completer import BatchFnCompleter, Completer
 from lipjax.baselines.interpolate import LinearFill, linear_fill
 from lipjax.baselines.ipbasic import IPBasicFill, ipbasic_fill
 from lipjax.baselines.nearest import NearestFill, nearest_fill
+from lipjax.inputs import check_frame
 
 __all__ = [
     "BatchFnCompleter",
@@ -26,7 +27,7 @@ __all__ = [
     "IPBasicFill",
     "LinearFill",
     "NearestFill",
-    "check_inputs",
+    "check_frame",
     "classical_completers",
     "colorization_fill",
     "ipbasic_fill",

@@ -29,7 +29,7 @@ import numpy as np
 from scipy import sparse as sp
 from scipy.sparse import linalg as spla
 
-from lipjax.baselines.completer import check_inputs
+from lipjax.inputs import check_frame
 
 _OFFSETS = [(dy, dx) for dy in (-1, 0, 1) for dx in (-1, 0, 1) if (dy, dx) != (0, 0)]
 VARIANCE_SCALE = 0.6
@@ -136,5 +136,5 @@ class ColorizationFill:
     name: str = "colorization"
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        rgb, sparse = check_inputs(rgb, sparse)
+        rgb, sparse = check_frame(rgb, sparse)
         return colorization_fill(rgb, sparse)

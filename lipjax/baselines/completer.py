@@ -16,6 +16,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from lipjax.inputs import check_frame
+
 
 @runtime_checkable
 class Completer(Protocol):
@@ -24,32 +26,6 @@ class Completer(Protocol):
     name: str
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray: ...
-
-
-def check_inputs(rgb: Any, sparse: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Validates one frame's inputs; returns (rgb uint8 (H, W, 3), sparse float32 (H, W)).
-
-    Raises ValueError with a message naming the problem for: a wrong rank or channel count, rgb not uint8,
-    mismatching (H, W), NaN / inf or negative sparse depth, and a sparse map without any sample (> 0).
-    """
-    rgb = np.asarray(rgb)
-    sparse = np.asarray(sparse)
-    if rgb.ndim != 3 or rgb.shape[2] != 3:
-        raise ValueError(f"rgb must be (H, W, 3), got shape {rgb.shape}")
-    if rgb.dtype != np.uint8:
-        raise ValueError(f"rgb must be uint8, got {rgb.dtype}")
-    if sparse.ndim != 2:
-        raise ValueError(f"sparse depth must be (H, W), got shape {sparse.shape}")
-    if sparse.shape != rgb.shape[:2]:
-        raise ValueError(f"shape mismatch: rgb {rgb.shape[:2]} vs sparse {sparse.shape}")
-    sparse = sparse.astype(np.float32, copy=False)
-    if not np.all(np.isfinite(sparse)):
-        raise ValueError("sparse depth contains NaN or inf; use 0 for 'no sample'")
-    if np.any(sparse < 0):
-        raise ValueError("sparse depth contains negative values; depth is in metres, 0 = no sample")
-    if not np.any(sparse > 0):
-        raise ValueError("sparse depth map is empty: no pixel > 0, nothing to complete from")
-    return rgb, sparse
 
 
 @dataclasses.dataclass
@@ -65,7 +41,7 @@ class BatchFnCompleter:
     fn: Callable[[Any, Any], Any]
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        rgb, sparse = check_inputs(rgb, sparse)
+        rgb, sparse = check_frame(rgb, sparse)
         out = self.fn((rgb.astype(np.float32) / 255.0)[None], sparse[None])
         out = np.asarray(out, dtype=np.float32)
         if out.shape != (1,) + sparse.shape:

@@ -18,8 +18,8 @@ import dataclasses
 import numpy as np
 from scipy import spatial
 
-from lipjax.baselines.completer import check_inputs
 from lipjax.baselines.nearest import nearest_fill
+from lipjax.inputs import check_frame
 
 # Barycentric coordinates down to -eps count as inside, so pixels exactly on an edge are never lost to rounding.
 _INSIDE_EPS = 1e-9
@@ -86,5 +86,5 @@ class LinearFill:
     name: str = "linear"
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        _, sparse = check_inputs(rgb, sparse)
+        _, sparse = check_frame(rgb, sparse)
         return linear_fill(sparse)

@@ -40,7 +40,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from lipjax.baselines.completer import check_inputs
+from lipjax.inputs import check_frame
 
 MIN_RADIUS_PX = 1
 MAX_RADIUS_PX = 64
@@ -144,7 +144,7 @@ class IPBasicFill:
     sigma_color_m: float | None = None
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        _, sparse = check_inputs(rgb, sparse)
+        _, sparse = check_frame(rgb, sparse)
         return ipbasic_fill(
             sparse,
             radius_px=self.radius_px,

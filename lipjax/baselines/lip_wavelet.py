@@ -18,8 +18,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.admm import unrolled_admm
-from lipjax.baselines.completer import check_inputs
 from lipjax.fill import box_fill
+from lipjax.inputs import check_frame
 from lipjax.priors.wavelet import WaveletPrior
 
 
@@ -35,7 +35,7 @@ class LIPWavelet:
     name: str = "lip-wavelet"
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        rgb, sparse = check_inputs(rgb, sparse)
+        rgb, sparse = check_frame(rgb, sparse)
         return np.asarray(_solver(self.iterations, self.rho, self.levels, self.shifts, self.tau_per_m_depth)(sparse))
 
 

@@ -10,13 +10,13 @@ import dataclasses
 import numpy as np
 from scipy import ndimage
 
-from lipjax.baselines.completer import check_inputs
+from lipjax.inputs import check_frame
 
 
 def nearest_fill(sparse: np.ndarray) -> np.ndarray:
     """(H, W) float32 metres, 0 = no sample -> (H, W) float32 dense, nearest sample's depth everywhere.
 
-    Assumes at least one sample (> 0); callers validate with `check_inputs`.
+    Assumes at least one sample (> 0); callers validate with `lipjax.inputs.check_frame`.
     """
     # The EDT of the "no sample" mask returns, for each pixel, the index of the nearest zero of that mask,
     # i.e. of the nearest sample.
@@ -31,5 +31,5 @@ class NearestFill:
     name: str = "nearest"
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        _, sparse = check_inputs(rgb, sparse)
+        _, sparse = check_frame(rgb, sparse)
         return nearest_fill(sparse)
