@@ -55,11 +55,11 @@ LIP_CNN_INDOOR = TrainConfig(
 )
 LIP_CNN_OUTDOOR = dataclasses.replace(
     LIP_CNN_INDOOR, name="lip-cnn-outdoor", model=_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE),
-    data=OUTDOOR_DATA,
+    data=OUTDOOR_DATA, g_steps=900,
 )
 # LIP+AD: start from the LIP+CNN model, pretrain D with G frozen, then train both (paper Sec. III-B).
 LIP_AD_INDOOR = dataclasses.replace(
-    LIP_CNN_INDOOR, name="lip-ad-indoor", init_from="lip-cnn-indoor", g_steps=0, d_steps=100, adv_steps=400,
+    LIP_CNN_INDOOR, name="lip-ad-indoor", init_from="lip-cnn-indoor", g_steps=0, d_steps=50, adv_steps=200,
     learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3, discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M),
 )
 LIP_AD_OUTDOOR = dataclasses.replace(
