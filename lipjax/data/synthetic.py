@@ -53,10 +53,10 @@ Approximations made for speed (all deterministic): shadow rays are cast for one 
 outdoors, objects wholly farther than 70 m cast no shadow; the sky is shaded at 1/4 resolution; objects
 covering fewer than 32 pixels get their material's mean colour instead of the full texture.
 
-Speed (`taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py`, one pinned core of the 2-CPU
-development machine while a training job kept its load average near 5): frames/s of CPU time, 256x320:
-indoor 27-30, outdoor 20-22 (about 28 at lighter load); 128x160: indoor 53-57, outdoor 35-43. Outdoor frames
-cost more: ~140 primitives against ~30 indoors. Per-primitive numpy calls are batched where the arithmetic
+Speed (`taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py --frames 40`, one pinned core of the 2-CPU
+development machine with the training jobs paused): frames/s of CPU time, 256x320: indoor 30.4 (val split,
+unpinned: 27.8), outdoor 25.0 (val: 21.7); 128x160: indoor 55, outdoor 31-34. With a training job beside it
+(load ~5): outdoor 256x320 20-22. Outdoor frames cost more: ~140 primitives against ~30 indoors. Per-primitive numpy calls are batched where the arithmetic
 allows it without changing a bit of the output (small parts' camera rays, box and cylinder surfaces, shadow
 rays: one call per primitive kind); textures (one call per material) and scene construction (Python) remain
 per object.
