@@ -1,0 +1,186 @@
+"""The public entry points: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`.
+
+Argument checks, per-frame seeds and sample ids live here; a frame is built by the `indoor` / `outdoor` scene
+builders and drawn by `renderer`.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from typing import Iterator
+
+import numpy as np
+
+from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.synthetic.constants import (
+    DEFAULT_HEIGHT,
+    DEFAULT_SIZES,
+    DEFAULT_WIDTH,
+    KITTI_IMAGE_SIZE,
+    KITTI_INTRINSICS,
+    NYU_IMAGE_SIZE,
+    NYU_INTRINSICS,
+    SPLITS,
+    SYNTHETIC_KINDS,
+)
+from lipjax.data.synthetic.indoor import _indoor_scene
+from lipjax.data.synthetic.outdoor import _outdoor_scene
+from lipjax.data.synthetic.renderer import _render
+
+
+@dataclasses.dataclass(frozen=True)
+class SceneInfo:
+    """What was rendered, beyond the Sample: for tests, debugging and visualisation.
+
+    Attributes:
+      kind: "indoor" or "outdoor".
+      camera_to_world: (4, 4) float64; world = R @ camera + t. World y is up and the floor / road is y = 0.
+      camera_height_m: height of the camera centre above y = 0.
+      labels: (H, W) int8, index into LABELS per pixel (0 = sky).
+    """
+
+    kind: str
+    camera_to_world: np.ndarray
+    camera_height_m: float
+    labels: np.ndarray
+
+
+def _check_kind_split(kind: str, split: str) -> None:
+    if kind not in SYNTHETIC_KINDS:
+        raise ValueError(f"unknown synthetic kind {kind!r}; expected one of {SYNTHETIC_KINDS}")
+    if split not in SPLITS:
+        raise ValueError(f"unknown split {split!r}; expected one of {SPLITS}")
+
+
+def _check_index(index) -> int:
+    if isinstance(index, (bool, np.bool_)) or not isinstance(index, (int, np.integer)):
+        raise ValueError(f"index must be an int, got {index!r}")
+    if index < 0:
+        raise ValueError(f"index must be >= 0, got {index}")
+    return int(index)
+
+
+def _check_size(height, width) -> tuple[int, int]:
+    if not isinstance(height, (int, np.integer)) or not isinstance(width, (int, np.integer)) or height < 8 or width < 8:
+        raise ValueError(f"height and width must be ints >= 8, got {height!r} x {width!r}")
+    return int(height), int(width)
+
+
+def intrinsics_for(kind: str, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH) -> Intrinsics:
+    """The camera of `kind` ("indoor": NYU v2 `NYU_INTRINSICS`, "outdoor": KITTI `KITTI_INTRINSICS`) scaled
+    to height x width pixels, keeping square pixels.
+
+    The reference frame (480x640 / 375x1242) is centre-cropped to the largest window with the render's aspect
+    ratio, then resized isotropically (`Intrinsics.cropped`, then `Intrinsics.resized`, pixel-centre
+    convention). So a 4:3 render of NYU is exactly `NYU_INTRINSICS.resized(s, s)`; a 256x320 outdoor render
+    sees KITTI's vertical field of view (horizon at the same relative row) with a narrower horizontal one,
+    like a centre crop of a KITTI frame. A plain per-axis resize would squash KITTI's 3.3:1 frame into 4:5
+    and make pixels 2.6x taller than wide, unlike any real KITTI / NYU evaluation crop (lipjax.data.protocols
+    keeps pixels square).
+    """
+    if kind not in SYNTHETIC_KINDS:
+        raise ValueError(f"unknown synthetic kind {kind!r}; expected one of {SYNTHETIC_KINDS}")
+    height, width = _check_size(height, width)
+    ref, (h0, w0) = (NYU_INTRINSICS, NYU_IMAGE_SIZE) if kind == "indoor" else (KITTI_INTRINSICS, KITTI_IMAGE_SIZE)
+    if width * h0 <= height * w0:  # render narrower than the reference: crop columns
+        ch, cw = float(h0), h0 * width / height
+    else:  # wider: crop rows
+        ch, cw = w0 * height / width, float(w0)
+    return ref.cropped((h0 - ch) / 2, (w0 - cw) / 2).resized(height / ch, width / cw)
+
+
+def sample_id(kind: str, split: str, index: int) -> str:
+    """The Sample.id of a synthetic frame, e.g. "synthetic/indoor/val/000042"."""
+    return f"synthetic/{kind}/{split}/{index:06d}"
+
+
+def _seed(kind: str, split: str, index: int) -> int:
+    digest = hashlib.sha256(f"lipjax/synthetic/v1/{kind}/{split}/{index}".encode("utf-8")).digest()
+    return int.from_bytes(digest[:16], "little")
+
+
+def render_with_info(
+    kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH
+) -> tuple[Sample, SceneInfo]:
+    """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
+
+    Raises:
+      ValueError: unknown kind / split, a negative or non-integer index, or a size below 8 pixels.
+    """
+    _check_kind_split(kind, split)
+    index = _check_index(index)
+    height, width = _check_size(height, width)
+    seed = _seed(kind, split, index)
+    scene_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
+    noise_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
+    scene = _indoor_scene(scene_rng) if kind == "indoor" else _outdoor_scene(scene_rng)
+    intr = intrinsics_for(kind, height, width)
+    with np.errstate(all="ignore"):
+        rgb, depth, labels = _render(scene, height, width, intr, noise_rng)
+    sample = Sample.from_depth(rgb, depth, intr, sample_id(kind, split, index))
+    pose = np.eye(4)
+    pose[:3, :3] = scene.cam_R
+    pose[:3, 3] = scene.cam_pos
+    return sample, SceneInfo(kind, pose, float(scene.cam_pos[1]), labels)
+
+
+def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH) -> Sample:
+    """Renders frame `index` of the synthetic (kind, split) set as a Sample.
+
+    Args:
+      kind: "indoor" or "outdoor".
+      split: "train", "val" or "test" (disjoint scenes).
+      index: >= 0. Any non-negative int is a valid scene; `SyntheticDataset` bounds it by its size.
+      height, width: render size in pixels (the scene does not depend on it).
+    Returns:
+      Sample with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
+      than OUTDOOR_MAX_DEPTH_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W),
+      id = "synthetic/{kind}/{split}/{index:06d}".
+    """
+    return render_with_info(kind, split, index, height, width)[0]
+
+
+class _IndexOutOfRange(ValueError, IndexError):
+    """A ValueError (as documented) that is also an IndexError, so sequence idioms keep working."""
+
+
+class SyntheticDataset:
+    """A sized, indexable view of the procedural set: dataset[i] == render(kind, split, i, height, width).
+
+    Args:
+      kind: "indoor" or "outdoor".
+      split: "train", "val" or "test".
+      size: number of frames; None = DEFAULT_SIZES[split] (train 100000, val 200, test 200).
+      height, width: render size in pixels.
+    """
+
+    def __init__(self, kind: str, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT,
+                 width: int = DEFAULT_WIDTH):
+        _check_kind_split(kind, split)
+        if size is None:
+            size = DEFAULT_SIZES[split]
+        if isinstance(size, (bool, np.bool_)) or not isinstance(size, (int, np.integer)) or size < 0:
+            raise ValueError(f"size must be a non-negative int or None, got {size!r}")
+        self.kind, self.split, self.size = kind, split, int(size)
+        self.height, self.width = _check_size(height, width)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __getitem__(self, index: int) -> Sample:
+        index = _check_index(index)
+        if index >= self.size:
+            raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
+                                   f"of size {self.size}")
+        return render(self.kind, self.split, index, self.height, self.width)
+
+    def __iter__(self) -> Iterator[Sample]:
+        for i in range(self.size):
+            yield render(self.kind, self.split, i, self.height, self.width)
+
+    @property
+    def intrinsics(self) -> Intrinsics:
+        return intrinsics_for(self.kind, self.height, self.width)
+
+    def __repr__(self) -> str:
+        return f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, width={self.width})"
