@@ -343,9 +343,11 @@ def _cmd_export(args) -> int:
     except ImportError as exc:
         raise CLIError(str(exc)) from exc
     if not args.quiet:
-        print(f"wrote {path} ({path.stat().st_size} bytes): rgb uint8 {(args.batch, args.height, args.width, 3)}, "
-              f"sparse float32 {(args.batch, args.height, args.width)} m -> depth m; platforms {list(exported.platforms)}",
-              file=sys.stderr)
+        shape = (args.batch, args.height, args.width)
+        z0 = (f", z0 float32 {shape} m (the model's {completer.config.initial_estimate} fill of sparse, computed "
+              "outside: lipjax.model.host_initial_estimate)") if len(exported.in_avals) == 3 else ""
+        print(f"wrote {path} ({path.stat().st_size} bytes): rgb uint8 {shape + (3,)}, sparse float32 {shape} m{z0} "
+              f"-> depth m; platforms {list(exported.platforms)}", file=sys.stderr)
     return 0
 
 
