@@ -17,7 +17,7 @@ import numpy as np
 
 from lipjax import model_io
 from lipjax.inputs import InputError, check_inputs  # noqa: F401  (re-exported: lipjax.InputError)
-from lipjax.model import LIPConfig
+from lipjax.model import LIPConfig, host_inputs_of
 
 DEFAULT_MODEL = "lip-ad-indoor"
 
@@ -29,10 +29,6 @@ def _compiled(config: LIPConfig, return_trajectory: bool):
 
     return jax.jit(run)
 
-
-def _host_inputs(config, sparse: np.ndarray) -> dict:
-    """Inputs computed outside jit (a Delaunay initial estimate, ...); {} for models that need none."""
-    return config.host_inputs(sparse) if hasattr(config, "host_inputs") else {}
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -70,14 +66,14 @@ class Completer:
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
         rgb, sparse, batched = check_inputs(rgb, sparse)
-        depth, _ = _compiled(self.config, False)(self.params, rgb, sparse, _host_inputs(self.config, sparse))
+        depth, _ = _compiled(self.config, False)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
         rgb, sparse, _ = check_inputs(rgb, sparse)
-        return _compiled(self.config, True)(self.params, rgb, sparse, _host_inputs(self.config, sparse))
+        return _compiled(self.config, True)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)

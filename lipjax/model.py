@@ -179,6 +179,11 @@ def apply(
     )
 
 
+def host_inputs_of(config: Any, sparse: np.ndarray) -> dict[str, np.ndarray]:
+    """`config.host_inputs(sparse)` for any model config; {} for models without host inputs (the baselines)."""
+    return config.host_inputs(sparse) if hasattr(config, "host_inputs") else {}
+
+
 def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
     """(B, H, W) float32 metres: the "linear" or "nearest" fill of each image of (B, H, W) sparse depth (0 = none).
 

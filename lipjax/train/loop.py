@@ -29,6 +29,7 @@ from lipjax.data.sample import Batch
 from lipjax.data.sampling import example_rng, sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.metrics import MetricAggregator, compute_metrics
+from lipjax.model import host_inputs_of
 from lipjax.train.config import TrainConfig
 from lipjax.train.state import TrainState, init_state  # noqa: F401  (re-exported)
 from lipjax.train.steps import make_steps
@@ -66,7 +67,7 @@ def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int
 
 def with_host_inputs(model_config, batch: Batch) -> Batch:
     """Adds the host-computed initial estimate z0 to a (cropped) batch for models that need one."""
-    extra = model_config.host_inputs(batch.sparse) if hasattr(model_config, "host_inputs") else {}
+    extra = host_inputs_of(model_config, batch.sparse)
     return dataclasses.replace(batch, **extra) if extra else batch
 
 
