@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from lipjax.baselines.completer import Completer
+from lipjax.baselines.completer import DepthCompleter
 from lipjax.data.sample import Sample
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 
@@ -86,7 +86,7 @@ class EvalResult:
 
 
 def evaluate(
-    completer: Completer,
+    completer: DepthCompleter,
     dataset: Sequence[Sample],
     sampler: Sampler,
     *,

@@ -24,6 +24,31 @@ def depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, kind: str = 
     raise ValueError(f"loss kind must be 'l2' or 'l1', got {kind!r}")
 
 
+def soft_floored_inverse(depth: jax.Array, floor_m: float) -> jax.Array:
+    """1 / depth (1/m) for depth >= floor_m, continued below the floor by its tangent line, 1/f + (f - depth)/f^2.
+
+    The continuation keeps the value finite and the gradient pushing up for near-zero and negative depths, where
+    a plain clamp max(depth, f) would have no gradient at all."""
+    safe = jnp.where(depth >= floor_m, depth, floor_m)  # where, not maximum: maximum halves the gradient at f
+    return jnp.where(depth >= floor_m, 1.0 / safe, 1.0 / floor_m + (floor_m - depth) / floor_m**2)
+
+
+def inverse_depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, floor_m: float = 1.0) -> jax.Array:
+    """Inverse-depth error of (B, H, W) depths in 1/m, with pred softly floored (`soft_floored_inverse`):
+    mean |1/pred - 1/gt| over valid pixels, plus, over the pixels without ground truth, the mean of how far
+    1/pred rises above 1/floor_m (0 for any depth >= floor_m: there only a too-small depth is known to be wrong).
+
+    Why: a depth loss barely sees a few pixels predicted near zero or negative (thin structures far from any
+    measurement), yet each dominates the inverse-depth metrics (iRMSE, iMAE) of KITTI; in inverse depth their
+    error is large and the gradient strong. The second term keeps the output physical where no ground truth
+    exists (sky), so the network has no unsupervised region in which it may learn negative depth. Ground truth
+    nearer than floor_m asks for exactly the floor."""
+    inverse = soft_floored_inverse(pred, floor_m)
+    target = 1.0 / jnp.maximum(gt, floor_m)
+    below_floor = jnp.maximum(inverse - 1.0 / floor_m, 0.0)
+    return masked_mean(jnp.abs(inverse - target), valid) + masked_mean(below_floor, ~valid.astype(bool))
+
+
 def supervised_loss(
     final: jax.Array,
     iterates: jax.Array | None,
@@ -33,10 +58,15 @@ def supervised_loss(
     kind: str = "l2",
     scale_m: float = 1.0,
     iteration_weights: tuple[float, ...] = (),
+    inverse_depth_weight: float = 0.0,
+    inverse_depth_floor_m: float = 1.0,
 ) -> jax.Array:
     """Loss on the final estimate plus optional deep supervision: sum_k w_k * loss(x_k) over the first
-    len(iteration_weights) iterates (iterates: (K, B, H, W))."""
+    len(iteration_weights) iterates (iterates: (K, B, H, W)). With inverse_depth_weight > 0 the final estimate's
+    `inverse_depth_loss` (1/m) is added with that weight."""
     loss = depth_loss(final, gt, valid, kind=kind, scale_m=scale_m)
+    if inverse_depth_weight:
+        loss = loss + inverse_depth_weight * inverse_depth_loss(final, gt, valid, floor_m=inverse_depth_floor_m)
     for k, w in enumerate(iteration_weights):
         if w:
             loss = loss + w * depth_loss(iterates[k], gt, valid, kind=kind, scale_m=scale_m)

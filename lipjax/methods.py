@@ -4,21 +4,21 @@
     get_method("lip-wavelet")         LIP with the hand-crafted wavelet soft-thresholding prox (no training)
     get_method("colorization")        classical fills: nearest, linear, ip_basic, colorization
 
-All are `Completer`s: completer(rgb (H,W,3) uint8, sparse (H,W) float32 metres) -> (H,W) float32 metres, with
+All are `DepthCompleter`s: completer(rgb (H,W,3) uint8, sparse (H,W) float32 metres) -> (H,W) float32 m, with
 a `name`.
 """
 from __future__ import annotations
 
 from lipjax import model_io
-from lipjax.baselines.completer import Completer
-from lipjax.baselines.registry import COMPLETERS, make_completer
+from lipjax.baselines.completer import DepthCompleter
 from lipjax.baselines.lip_wavelet import LIPWavelet
+from lipjax.baselines.registry import COMPLETERS, make_completer
 from lipjax.inference import load_model
 
 SCENES = ("indoor", "outdoor")
 
 
-def get_method(name: str) -> Completer:
+def get_method(name: str) -> DepthCompleter:
     """A completer by name (see the module docstring)."""
     if name in COMPLETERS:
         return make_completer(name)

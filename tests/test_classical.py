@@ -7,14 +7,14 @@ from scipy import interpolate
 from lipjax.baselines.classical import (
     BatchFnCompleter,
     ColorizationFill,
-    Completer,
+    DepthCompleter,
     IPBasicFill,
     LinearFill,
     NearestFill,
     classical_completers,
     nearest_fill,
 )
-from lipjax.baselines.colorization import luma, neighbour_weights, nested_dissection_order, _OFFSETS
+from lipjax.baselines.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
 from lipjax.baselines.ipbasic import auto_radii_px, diamond_kernel
 from lipjax.baselines.registry import COMPLETERS, make_completer
 
@@ -37,7 +37,7 @@ def _gray(h, w, value=128):
 def test_output_contract(completer):
     s = _random_sparse(24, 30, 20)
     out = completer(_gray(24, 30), s)
-    assert isinstance(completer, Completer)
+    assert isinstance(completer, DepthCompleter)
     assert out.shape == (24, 30) and out.dtype == np.float32
     assert np.all(np.isfinite(out))
     # no method may leave the range of its samples by much (all are interpolators or local averages)

@@ -11,7 +11,9 @@ from lipjax.losses import (
     depth_loss,
     discriminator_loss,
     generator_adversarial_loss,
+    inverse_depth_loss,
     masked_mean,
+    soft_floored_inverse,
     supervised_loss,
 )
 
@@ -36,6 +38,31 @@ def test_deep_supervision_adds_weighted_iterate_losses():
     iterates = jnp.stack([gt + 2.0, gt + 3.0])  # losses 4, 9
     assert float(supervised_loss(final, iterates, gt, valid, iteration_weights=(0.5, 0.1))) == pytest.approx(1 + 2 + 0.9)
     assert float(supervised_loss(final, None, gt, valid)) == pytest.approx(1.0)
+
+
+def test_soft_floored_inverse_is_c1_and_pushes_non_positive_depths_up():
+    floor = 2.0
+    d = jnp.array([-3.0, 0.0, 1.0, 2.0, 4.0])
+    # tangent line of 1/d at d = 2 below the floor: 1/2 + (2 - d)/4; plain 1/d above it
+    np.testing.assert_allclose(soft_floored_inverse(d, floor), [1.75, 1.0, 0.75, 0.5, 0.25], rtol=1e-6)
+    grad = jax.vmap(jax.grad(lambda x: soft_floored_inverse(x, floor)))(d)
+    np.testing.assert_allclose(grad, [-0.25, -0.25, -0.25, -0.25, -1 / 16], rtol=1e-6)  # continuous at the floor
+
+
+def test_inverse_depth_loss_by_hand_and_in_the_supervised_loss():
+    pred = jnp.array([[[0.5, 4.0], [-1.0, 3.0]]])
+    gt = jnp.array([[[2.0, 2.0], [4.0, 0.0]]])
+    valid = gt > 0
+    # floor 1 m: |(1 + 0.5) - 0.5| = 1, |0.25 - 0.5| = 0.25, |(1 + 2) - 0.25| = 2.75 on the valid pixels; the
+    # invalid one (depth 3 m >= floor) costs nothing
+    assert float(inverse_depth_loss(pred, gt, valid, floor_m=1.0)) == pytest.approx((1 + 0.25 + 2.75) / 3)
+    depth_l1 = (1.5 + 2.0 + 5.0) / 3
+    total = supervised_loss(pred, None, gt, valid, kind="l1", inverse_depth_weight=0.5, inverse_depth_floor_m=1.0)
+    assert float(total) == pytest.approx(depth_l1 + 0.5 * 4 / 3)
+    # without ground truth only a depth below the floor is penalised: -1 m -> 1/f + (f + 1)/f^2 - 1/f = 2
+    below = jnp.array([[[-1.0, 5.0]]])
+    no_gt = jnp.zeros((1, 1, 2), bool)
+    assert float(inverse_depth_loss(below, jnp.zeros((1, 1, 2)), no_gt, floor_m=1.0)) == pytest.approx(1.0)
 
 
 def test_adversarial_losses_by_hand():

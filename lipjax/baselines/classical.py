@@ -1,4 +1,4 @@
-"""Hand-crafted depth completers, all behind the one `Completer` interface (lipjax.baselines.completer):
+"""Hand-crafted depth completers, all behind the one `DepthCompleter` interface (lipjax.baselines.completer):
 
     completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
@@ -14,7 +14,7 @@ baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
 from __future__ import annotations
 
 from lipjax.baselines.colorization import ColorizationFill, colorization_fill
-from lipjax.baselines.completer import BatchFnCompleter, Completer
+from lipjax.baselines.completer import BatchFnCompleter, DepthCompleter
 from lipjax.baselines.interpolate import LinearFill, linear_fill
 from lipjax.baselines.ipbasic import IPBasicFill, ipbasic_fill
 from lipjax.baselines.nearest import NearestFill, nearest_fill
@@ -23,7 +23,7 @@ from lipjax.inputs import check_frame
 __all__ = [
     "BatchFnCompleter",
     "ColorizationFill",
-    "Completer",
+    "DepthCompleter",
     "IPBasicFill",
     "LinearFill",
     "NearestFill",
@@ -36,6 +36,6 @@ __all__ = [
 ]
 
 
-def classical_completers() -> list[Completer]:
+def classical_completers() -> list[DepthCompleter]:
     """One instance of each classical completer with its default (density-adaptive) parameters."""
     return [NearestFill(), LinearFill(), IPBasicFill(), ColorizationFill()]

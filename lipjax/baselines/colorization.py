@@ -131,7 +131,7 @@ def colorization_fill(rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True)
 class ColorizationFill:
-    """Completer: Levin et al. colourisation fill guided by the image luma; samples are kept exactly."""
+    """DepthCompleter: Levin et al. colourisation fill guided by the image luma; samples are kept exactly."""
 
     name: str = "colorization"
 

@@ -4,7 +4,8 @@ A completer maps one frame to a dense depth map:
 
     completer(rgb: (H, W, 3) uint8, sparse: (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
-and has a `name` (used as the row label of result tables). One frame per call keeps classical methods simple;
+and has a `name` (used as the row label of result tables). A loaded learned model (`lipjax.Completer`, from
+`lipjax.inference`) is one. One frame per call keeps classical methods simple;
 learned models (jitted functions on batches) are wrapped by `BatchFnCompleter`, which adds and removes a
 batch axis of size 1.
 """
@@ -20,7 +21,7 @@ from lipjax.inputs import check_frame
 
 
 @runtime_checkable
-class Completer(Protocol):
+class DepthCompleter(Protocol):
     """Dense depth from an RGB image and sparse depth. See the module docstring for shapes and units."""
 
     name: str
@@ -30,7 +31,7 @@ class Completer(Protocol):
 
 @dataclasses.dataclass
 class BatchFnCompleter:
-    """Wraps a batched (typically jitted) function as a one-frame `Completer`.
+    """Wraps a batched (typically jitted) function as a one-frame `DepthCompleter`.
 
     `fn(rgb (1, H, W, 3) float32 in [0, 1], sparse (1, H, W) float32 metres) -> (1, H, W) metres`. The output is
     converted to numpy, which also waits for asynchronous JAX dispatch, so timing this call times the

@@ -81,7 +81,7 @@ def linear_fill(sparse: np.ndarray) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True)
 class LinearFill:
-    """Completer: Delaunay piecewise-linear interpolation, nearest fill outside the convex hull (ignores RGB)."""
+    """DepthCompleter: Delaunay piecewise-linear interpolation, nearest fill outside the convex hull (ignores RGB)."""
 
     name: str = "linear"
 

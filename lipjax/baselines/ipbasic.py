@@ -131,7 +131,7 @@ def ipbasic_fill(
 
 @dataclasses.dataclass(frozen=True)
 class IPBasicFill:
-    """Completer: IP-Basic-style morphological fill (ignores RGB). See `ipbasic_fill` for the parameters.
+    """DepthCompleter: IP-Basic-style morphological fill (ignores RGB). See `ipbasic_fill` for the parameters.
 
     The final median / bilateral filters also move the sampled pixels: unlike the other classical fills it is
     not exact at the samples (mae_vs_input_m > 0).

@@ -26,7 +26,7 @@ def nearest_fill(sparse: np.ndarray) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True)
 class NearestFill:
-    """Completer: nearest-neighbour fill (ignores the RGB image)."""
+    """DepthCompleter: nearest-neighbour fill (ignores the RGB image)."""
 
     name: str = "nearest"
 

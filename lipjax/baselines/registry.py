@@ -5,9 +5,9 @@ from collections.abc import Callable
 from typing import Any
 
 from lipjax.baselines.classical import ColorizationFill, IPBasicFill, LinearFill, NearestFill
-from lipjax.baselines.completer import Completer
+from lipjax.baselines.completer import DepthCompleter
 
-COMPLETERS: dict[str, Callable[..., Completer]] = {
+COMPLETERS: dict[str, Callable[..., DepthCompleter]] = {
     "nearest": NearestFill,
     "linear": LinearFill,
     "ip_basic": IPBasicFill,
@@ -15,7 +15,7 @@ COMPLETERS: dict[str, Callable[..., Completer]] = {
 }
 
 
-def make_completer(name: str, **kwargs: Any) -> Completer:
+def make_completer(name: str, **kwargs: Any) -> DepthCompleter:
     """Builds the completer registered as `name`, with dataclass fields overridden by kwargs."""
     if name not in COMPLETERS:
         raise ValueError(f"unknown completer {name!r}; known: {sorted(COMPLETERS)}")

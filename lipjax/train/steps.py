@@ -49,7 +49,9 @@ def make_steps(config: TrainConfig) -> Steps:
     def g_supervised(g_params, batch):
         out, iterates = g_forward(g_params, batch)
         loss = supervised_loss(out, iterates, batch["gt"], batch["gt_valid"], kind=config.loss, scale_m=scale,
-                               iteration_weights=config.iteration_weights)
+                               iteration_weights=config.iteration_weights,
+                               inverse_depth_weight=config.inverse_depth_weight,
+                               inverse_depth_floor_m=config.inverse_depth_floor_m)
         return loss, out
 
     def d_logits(d_params, depth, batch):
