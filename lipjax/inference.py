@@ -2,7 +2,8 @@
 
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
 same size, and returns dense depth in metres. The solver is compiled once per (config, input shape): jit caches
-one executable per shape, and `_compiled` caches the jitted function per config.
+one executable per shape, and `compiled_apply` caches the jitted function per config (the training loop's
+validation uses it too, so one compilation serves both).
 """
 from __future__ import annotations
 
@@ -23,7 +24,10 @@ DEFAULT_MODEL = "lip-ad-indoor"
 
 
 @functools.lru_cache(maxsize=None)
-def _compiled(config: LIPConfig, return_trajectory: bool):
+def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
+    """jit(config.apply) as (params, rgb, sparse, extra) -> (depth, trajectory or None); extra holds the
+    host-computed inputs (`lipjax.model.host_inputs_of`), e.g. {"z0": ...}, or is empty."""
+
     def run(params, rgb, sparse, extra):
         return config.apply(params, rgb, sparse, return_trajectory=return_trajectory, **extra)
 
@@ -66,14 +70,14 @@ class Completer:
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
         rgb, sparse, batched = check_inputs(rgb, sparse)
-        depth, _ = _compiled(self.config, False)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
+        depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
         rgb, sparse, _ = check_inputs(rgb, sparse)
-        return _compiled(self.config, True)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
+        return compiled_apply(self.config, True)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)

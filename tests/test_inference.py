@@ -36,7 +36,7 @@ def test_single_and_batched_calls_agree_and_keep_measurements(completer):
 
 
 def test_compiled_once_per_shape(completer):
-    fn = inference._compiled(CONFIG, False)
+    fn = inference.compiled_apply(CONFIG, False)
     for seed in range(3):
         completer(*_inputs(seed=seed))
     n = fn._cache_size()

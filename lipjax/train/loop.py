@@ -28,6 +28,7 @@ from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_
 from lipjax.data.sample import Batch
 from lipjax.data.sampling import example_rng, sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
+from lipjax.inference import compiled_apply
 from lipjax.metrics import MetricAggregator, compute_metrics
 from lipjax.model import host_inputs_of
 from lipjax.train.config import TrainConfig
@@ -82,26 +83,13 @@ def validation_batches(config: TrainConfig) -> list[Batch]:
 
 def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: float) -> dict[str, float]:
     """Per-image-then-mean metrics of a LIP model over batches (lipjax.metrics)."""
-    apply = _jitted_apply(model_config)
+    apply = compiled_apply(model_config)
     agg = MetricAggregator()
     for b in batches:
-        pred = np.asarray(apply(params, b.rgb, b.sparse, b.z0))
+        pred = np.asarray(apply(params, b.rgb, b.sparse, {} if b.z0 is None else {"z0": b.z0})[0])
         for i in range(len(pred)):
             agg.add(compute_metrics(pred[i], b.gt[i], b.gt_valid[i], b.sparse[i], min_depth_m=0.0, max_depth_m=max_depth_m))
     return agg.means()
-
-
-_APPLY_CACHE: dict = {}
-
-
-def _jitted_apply(model_config):
-    if model_config not in _APPLY_CACHE:
-        def run(params, rgb, sparse, z0):
-            extra = {} if z0 is None else {"z0": z0}
-            return model_config.apply(params, rgb, sparse, **extra)[0]
-
-        _APPLY_CACHE[model_config] = jax.jit(run)
-    return _APPLY_CACHE[model_config]
 
 
 def _to_float(metrics: dict) -> dict:
