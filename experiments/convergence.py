@@ -61,9 +61,11 @@ def train_k_models(scene: str, ks: list[int], steps: int, out: pathlib.Path) -> 
     base = CONFIGS[f"lip_cnn_{scene}"]
     paths = {}
     for k in ks:
+        # The shipped warm-up (100 steps) would take a whole short run: keep it to a tenth of the budget.
         config = dataclasses.replace(base, name=f"lip-cnn-{scene}-k{k}", g_steps=steps, eval_every=0,
+                                     warmup_steps=min(base.warmup_steps, max(1, steps // 10)),
                                      model=dataclasses.replace(base.model, num_iterations=k))
-        state = train(config, out / f"runs/k{k}")
+        state = train(config, out / f"runs/k{k}", progress=False)
         paths[k] = str(out / f"models/lip-cnn-{scene}-k{k}")
         export(config, state, paths[k])
     return paths
