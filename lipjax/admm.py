@@ -7,7 +7,10 @@ For k = 0 .. K-1 (scaled form):
     u_{k+1} = u_k + x_{k+1} - z_{k+1}                         # operators.dual_update
 
 and the returned estimate is one more x-update, x_out = x_update(y, w, z_K, u_K, rho_{K-1}), so that the output
-always carries the data-consistency guarantee of the x-update on measured pixels.
+always carries the data-consistency guarantee of the x-update on measured pixels. With final_dual=False it is
+x_update(y, w, z_K, 0, rho_{K-1}) instead: the last prox's estimate with the measurements re-imposed. On
+unmeasured pixels the default reads z_K - u_K = 2 z_K - x_K - u_{K-1}, which extrapolates the last prox's step;
+after a truncated unroll a large last step can overshoot (see LIPConfig.output).
 
 Initial state (z_0, u_0): u_0 = 0 (no constraint residual has been seen yet) and z_0 = an initial dense guess.
 With z_0 = y (the paper's setting: the first prox "makes a rough estimate of the depth on vacant pixels") the first
@@ -50,6 +53,7 @@ def unrolled_admm(
     shared_params: bool = False,
     return_trajectory: bool = False,
     unroll: bool = True,
+    final_dual: bool = True,
 ) -> tuple[jax.Array, Trajectory | None]:
     """Runs K = len(rho) ADMM iterations.
 
@@ -65,6 +69,7 @@ def unrolled_admm(
       return_trajectory: also return every iteration's x and z.
       unroll: unroll the scan. On CPU the rolled loop made a training step about 9x slower (jax issue 12868);
         K is small, so the compile-time cost of unrolling is modest.
+      final_dual: read the output with the last dual variable u_K (ADMM's x-iterate) or without it (see above).
 
     Returns:
       (x_out (B, H, W) metres, Trajectory or None).
@@ -94,5 +99,5 @@ def unrolled_admm(
 
     xs = {"rho": rho} if shared_params else {"rho": rho, "params": prox_params}
     (z, u), history = jax.lax.scan(step, (z, u), xs, unroll=unroll)
-    x_out = x_update(y, weights, z, u, rho[-1])
+    x_out = x_update(y, weights, z, u if final_dual else jnp.zeros_like(u), rho[-1])
     return x_out, (Trajectory(*history) if return_trajectory else None)

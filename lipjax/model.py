@@ -29,6 +29,7 @@ InitialEstimate = Literal["sparse", "box_fill", "linear", "nearest"]
 HOST_INITIAL_ESTIMATES = ("linear", "nearest")
 INITIAL_ESTIMATES = ("sparse", "box_fill") + HOST_INITIAL_ESTIMATES
 Guidance = Literal["rgb", "rgb+mask"]
+Output = Literal["x", "z"]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -49,6 +50,11 @@ class LIPConfig:
       guidance: what the prox sees besides depth. "rgb": the image (the paper). "rgb+mask": also the sampling
         mask and the fill's distance to the nearest sample, log2(1 + r) / 8 — with a dense z_0 the prox could
         otherwise not tell measured depth from extrapolated depth.
+      output: how the estimate is read after the K iterations. "x": one more x-update with z_K - u_K (ADMM's
+        x-iterate; the paper, and every shipped model). "z": the x-update with z_K alone, i.e. the last prox's
+        estimate with the measurements re-imposed. Measured pixels keep the x-update's guarantee either way; on
+        the others "x" reads 2 z_K - x_K - u_{K-1}, which extrapolates the last prox's step: on the outdoor model
+        this turned a few pixels where the last prox jumped by ~10 m into negative depth.
     """
 
     prior: Any = dataclasses.field(default_factory=lambda: network_preset("small"))
@@ -58,6 +64,7 @@ class LIPConfig:
     learn_rho: bool = True
     initial_estimate: InitialEstimate = "box_fill"
     guidance: Guidance = "rgb+mask"
+    output: Output = "x"
 
     # The model interface shared with the end-to-end baselines (lipjax.baselines): a hashable config object with
     # init / apply / parameter_count, so that training, inference, export and model files treat them alike.
@@ -94,6 +101,8 @@ class LIPConfig:
             raise ValueError(f"rho_init must be > 0, got {self.rho_init}")
         if self.guidance not in ("rgb", "rgb+mask"):
             raise ValueError(f"guidance must be 'rgb' or 'rgb+mask', got {self.guidance!r}")
+        if self.output not in ("x", "z"):
+            raise ValueError(f"output must be 'x' or 'z', got {self.output!r}")
         if self.initial_estimate not in INITIAL_ESTIMATES:
             raise ValueError(f"initial_estimate must be one of {INITIAL_ESTIMATES}, got {self.initial_estimate!r}")
 
@@ -176,6 +185,7 @@ def apply(
         z0=z0,
         shared_params=config.shared_prox,
         return_trajectory=return_trajectory,
+        final_dual=config.output == "x",
     )
 
 

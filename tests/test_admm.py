@@ -55,6 +55,26 @@ def test_scan_equals_python_loop_per_iteration_params(unroll):
     assert traj.x.shape == (k, *y.shape)
 
 
+def test_output_without_the_final_dual_is_the_last_prox_with_measurements_reimposed():
+    y, m, rgb = _sparse_problem(3)
+    params = {"a": jnp.array([0.8, 1.3]), "b": jnp.array([0.2, -0.4]), "c": jnp.array([0.5, 1.0])}
+    rhos = jnp.array([0.3, 0.2])
+    out, traj = unrolled_admm(_toy_prox, params, y, m, rgb, rhos, return_trajectory=True, final_dual=False)
+    z_last = traj.z[-1]
+    np.testing.assert_allclose(out, x_update(y, m, z_last, jnp.zeros_like(y), rhos[-1]), rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(out[m == 0], z_last[m == 0], rtol=1e-6)  # unmeasured: exactly z_K
+    # the default reads z_K - u_K there, which differs once the last prox moved its input
+    default, _ = unrolled_admm(_toy_prox, params, y, m, rgb, rhos)
+    assert float(jnp.max(jnp.abs(default - out))) > 1e-2
+    # through the model config: output="z" selects it, anything else is a clear error
+    config = lip_model.LIPConfig(prior=network_preset("tiny"), num_iterations=2, output="z", initial_estimate="sparse")
+    lip_params = config.init(jax.random.key(0))
+    out_z, traj_z = config.apply(lip_params, rgb, y, return_trajectory=True)
+    np.testing.assert_allclose(np.asarray(out_z)[m == 0], np.asarray(traj_z.z[-1])[m == 0], rtol=1e-6)
+    with pytest.raises(ValueError, match="output must be"):
+        lip_model.LIPConfig(output="u")
+
+
 def test_shared_params_equal_repeated_per_iteration_params():
     y, m, rgb = _sparse_problem(1)
     shared = {"a": jnp.float32(0.7), "b": jnp.float32(0.2), "c": jnp.float32(0.1)}
