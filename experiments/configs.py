@@ -74,7 +74,8 @@ LIP_AD_INDOOR = dataclasses.replace(
 LIP_AD_OUTDOOR = dataclasses.replace(
     LIP_AD_INDOOR, name="lip-ad-outdoor", model=LIP_CNN_OUTDOOR.model, data=OUTDOOR_DATA,
     init_from="lip-cnn-outdoor", discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M),
-    inverse_depth_weight=LIP_CNN_OUTDOOR.inverse_depth_weight, inverse_depth_floor_m=LIP_CNN_OUTDOOR.inverse_depth_floor_m,
+    inverse_depth_weight=LIP_CNN_OUTDOOR.inverse_depth_weight,
+    inverse_depth_floor_m=LIP_CNN_OUTDOOR.inverse_depth_floor_m,
 )
 
 # End-to-end learned baselines (lipjax.baselines.networks; Ma et al. [2], U-Net [6], CSPN [7]): the same data,
