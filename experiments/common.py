@@ -118,7 +118,7 @@ def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequenc
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     for name, ys in series.items():
-        ax.plot(xs, ys, "o-", label=name, linestyle="--" if "wavelet" in name else "-")
+        ax.plot(xs, ys, marker="o", label=name, linestyle="--" if "wavelet" in name else "-")
     if logx:
         ax.set_xscale("log")
     ax.set_xlabel(xlabel)

@@ -16,7 +16,7 @@ import dataclasses
 import json
 import pathlib
 
-from experiments.common import evaluate_methods, synthetic_outdoor_test
+from experiments.common import evaluate_methods, line_plot, synthetic_outdoor_test
 from lipjax.data.protocols import ProtocolView, get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
@@ -36,6 +36,18 @@ class Config:
 
 
 VARIANTS = {"default": Config(), "smoke": Config(point_counts=(200,), limit=1, methods=("nearest",))}
+
+
+def plot_blocks(doc: dict, point_counts, out: pathlib.Path) -> list[pathlib.Path]:
+    """One PNG per data block of results.json: every method's RMSE (m) against the number of samples."""
+    paths = []
+    blocks = sorted({key.rsplit(", ", 1)[0] for key in doc["blocks"]})
+    for i, block in enumerate(blocks):
+        per_n = [doc["blocks"][f"{block}, {n} points"] for n in point_counts]
+        series = {m: [rows[m]["rmse_m"] for rows in per_n] for m in per_n[0]}
+        paths.append(out / f"table3_block{i}.png")
+        line_plot(paths[-1], list(point_counts), series, xlabel="number of samples", ylabel="RMSE (m)", title=block)
+    return paths
 
 
 def main(argv=None) -> dict:
@@ -78,6 +90,7 @@ def main(argv=None) -> dict:
             md.append(f"### {key}\n\n{markdown_table(results, COLUMNS)}\n")
     (out / "results.json").write_text(json.dumps(doc, indent=1, default=lambda x: None))
     (out / "table.md").write_text("# Table III (embedded data)\n\n" + "\n".join(md))
+    plot_blocks(doc, config.point_counts, out)
     print("\n".join(md))
     return doc
 

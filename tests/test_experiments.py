@@ -34,6 +34,7 @@ def test_kitti_dc_smoke(tmp_path):
 def test_table3_and_sample_rate_smoke(tmp_path):
     doc = table3.main(["--variant", "smoke", "--out", str(tmp_path / "t3")])
     assert len(doc["blocks"]) == 2
+    assert (tmp_path / "t3" / "table3_block0.png").exists() and (tmp_path / "t3" / "table3_block1.png").exists()
     table = sample_rate.main(["--variant", "smoke", "--out", str(tmp_path / "sr")])
     assert set(table["nearest"]) == {50, 200}
     # more samples, smaller error (on the same frame, same seed scheme)
