@@ -168,7 +168,10 @@ def test_baseline_training_configs_copy_the_lip_runs():
         scene = key.split("_")[1]
         lip = configs.LIP_CNN_INDOOR if scene == "indoor" else configs.LIP_CNN_OUTDOOR
         assert config.name == key.replace("_", "-")
-        assert dataclasses.replace(config, name=lip.name, model=lip.model) == lip  # only name and model differ
+        # only name and model differ, and the end-to-end networks train without the inverse-depth term
+        assert config.inverse_depth_weight == 0.0
+        same = dataclasses.replace(config, name=lip.name, model=lip.model, inverse_depth_weight=lip.inverse_depth_weight)
+        assert same == lip
         assert config.model.max_depth_m == lip.model.max_depth_m
         assert model_io.config_from_dict(model_io.config_to_dict(config.model)) == config.model
         assert config.total_steps == config.g_steps and not config.iteration_weights  # supervised only, no trajectory
