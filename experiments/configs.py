@@ -55,8 +55,9 @@ LIP_CNN_INDOOR = TrainConfig(
     batch_size=8, g_steps=1200, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
 )
 # Outdoors the L1 depth loss alone left 123 validation pixels (in 10 of 32 frames) below 1 m, mostly negative (down
-# to -15 m against ~15 m truth): thin poles above the top LiDAR beam, in a region that is mostly sky and so unsupervised. A handful of such pixels costs the
-# depth loss nothing but ruins the inverse-depth metrics (val iRMSE 4135 1/km against 13 for the nearest fill).
+# to -15 m against ~15 m truth): thin poles above the top LiDAR beam, in a region that is mostly sky and so
+# unsupervised. A handful of such pixels costs the depth loss nothing but ruins the inverse-depth metrics (val
+# iRMSE 4135 1/km against 13 for the nearest fill).
 # The inverse-depth term (lipjax.losses.inverse_depth_loss, in 1/m, floor 1 m) weighs them heavily and also
 # penalises depth below the floor where no ground truth exists. It left 2 such pixels in the 32 validation
 # frames (iRMSE 177 1/km), both made by the final dual step, whose output z_K - u_K = 2 z_K - x_K - u_{K-1}
