@@ -65,10 +65,25 @@ def train_k_models(scene: str, ks: list[int], steps: int, out: pathlib.Path) -> 
         config = dataclasses.replace(base, name=f"lip-cnn-{scene}-k{k}", g_steps=steps, eval_every=0,
                                      warmup_steps=min(base.warmup_steps, max(1, steps // 10)),
                                      model=dataclasses.replace(base.model, num_iterations=k))
-        state = train(config, out / f"runs/k{k}", progress=False)
         paths[k] = str(out / f"models/lip-cnn-{scene}-k{k}")
+        if _finished(paths[k], config):
+            print(f"[lipjax] K = {k}: reusing {paths[k]} (trained {steps} steps with this config)")
+            continue
+        # train() resumes from the run's checkpoints, so a killed sweep picks up where it stopped
+        state = train(config, out / f"runs/k{k}", progress=False)
         export(config, state, paths[k])
     return paths
+
+
+def _finished(path: str, config) -> bool:
+    """Whether `path` holds a model exported by a finished run of `config` (same model, same step budget)."""
+    from lipjax import model_io
+
+    if not (pathlib.Path(path + ".json").exists() and pathlib.Path(path + ".msgpack").exists()):
+        return False
+    model_config, _, metadata = model_io.load(path)
+    return (model_config == config.model and metadata.get("train_config") == config.name
+            and metadata.get("steps") == config.total_steps)
 
 
 def main(argv=None) -> dict:

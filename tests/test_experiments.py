@@ -51,3 +51,20 @@ def test_convergence_smoke_with_a_saved_model(tmp_path):
     # an untrained (identity) prox leaves the data-consistent initial fill unchanged at every iteration
     np.testing.assert_allclose(curve, curve[0], rtol=1e-4)
     assert (tmp_path / "c" / "convergence.png").exists()
+
+
+def test_convergence_reuses_only_a_finished_k_model_of_the_same_config(tmp_path):
+    import dataclasses
+
+    from experiments.configs import SMOKE
+
+    params = SMOKE.model.init(jax.random.key(0))
+    path = str(tmp_path / "k2")
+    assert not convergence._finished(path, SMOKE)  # nothing there yet
+    model_io.save(path, SMOKE.model, params, {"train_config": SMOKE.name, "steps": SMOKE.total_steps})
+    assert convergence._finished(path, SMOKE)
+    assert not convergence._finished(path, dataclasses.replace(SMOKE, g_steps=SMOKE.g_steps + 1))  # budget
+    other_k = dataclasses.replace(SMOKE, model=dataclasses.replace(SMOKE.model, num_iterations=3))
+    assert not convergence._finished(path, other_k)
+    model_io.save(path, SMOKE.model, params, {"train_config": SMOKE.name, "steps": SMOKE.total_steps - 1})
+    assert not convergence._finished(path, SMOKE)  # a run stopped early

@@ -177,3 +177,20 @@ def test_four_devices_match_one_device():
     max_diff, max_move = float(line[1]), float(line[3])
     assert max_move > 1e-4  # training moved the parameters ...
     assert max_diff < 1e-4 * max(1.0, max_move) + 1e-5  # ... identically up to float reduction order
+
+
+def test_config_overrides_reach_nested_fields_convert_types_and_reject_unknown_names():
+    from experiments.configs import CONFIGS, get_config
+
+    config = get_config("smoke", {"g_steps": "7", "data.num_workers": "3", "model.num_iterations": "4"})
+    assert (config.g_steps, config.data.num_workers, config.model.num_iterations) == (7, 3, 4)
+    assert config.data.kind == CONFIGS["smoke"].data.kind  # the rest of the group is kept
+    with pytest.raises(ValueError, match="data.nope"):
+        get_config("smoke", {"data.nope": "1"})
+    with pytest.raises(ValueError, match="is a group"):
+        get_config("smoke", {"data": "1"})
+    with pytest.raises(ValueError, match="has no sub-fields"):
+        get_config("smoke", {"g_steps.x": "1"})
+    assert get_config("smoke", {"model.learn_rho": "false"}).model.learn_rho is False
+    with pytest.raises(ValueError, match="true or false"):
+        get_config("smoke", {"model.learn_rho": "no"})

@@ -164,6 +164,10 @@ def train(
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
                 images += config.batch_size
                 done = step + 1
+                if step == start:
+                    # The first step compiles (a minute or more here): leave it out of the images/s rate.
+                    jax.block_until_ready(state)
+                    t_last, images = time.perf_counter(), 0
                 if done % config.log_every == 0 or done == end:
                     metrics = _to_float(metrics)
                     if not math.isfinite(metrics["loss"]):
