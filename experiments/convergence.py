@@ -3,11 +3,13 @@
   1. a trained K-iteration model evaluated after each of its iterations (its x-iterates: 0 prox steps = the
      data-consistent initial fill, then one point per learned prox, the last being the model's output);
   2. (--train-k 1,2,3,5) models trained from scratch with K = 1, 2, 3, 5 iterations for --train-steps steps each
-     (a smaller budget than the shipped models; say so when reporting).
+     (a smaller budget than the shipped models; say so when reporting). A finished K-model already exported to
+     --out/models (same config and budget) is reused, and a killed run resumes from its checkpoints in --out/runs,
+     so the models can also be trained elsewhere (e.g. on a GPU with experiments.train) and evaluated here.
 
     python -m experiments.convergence [--scene indoor] [--train-k 1,2,3,5 --train-steps 300] [--variant smoke]
 
-Writes results.json, table.md and convergence.png into --out (default out/convergence).
+Writes results.json, table.md, convergence.png (and trained_k.png) into --out (default out/convergence).
 """
 from __future__ import annotations
 
