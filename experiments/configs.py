@@ -86,8 +86,8 @@ LIP_AD_OUTDOOR = dataclasses.replace(
 #     ma2018_*  SparseToDense, ResNet-34 basic blocks at 1/4 width, random init   1,553,369 parameters
 #     unet_*    UNet, base width 14, 4 levels                                      1,488,439 parameters
 #     cspn_*    CSPN, U-Net backbone of base width 14, 12 propagation steps        1,489,567 parameters
-# The shipped cspn_* weights were trained on one H100 (JAX 0.11.2, --set data.num_workers=5; ~8 min each, bound by
-# the CPU rendering the synthetic scenes); every other shipped model on the 2-core CPU. The configs are the same.
+# The shipped cspn_* weights were trained on one H100 (JAX 0.11.2, --set data.num_workers=5, 10-12 min each beside
+# other runs, bound by the CPU rendering the synthetic scenes); every other shipped model on the 2-core CPU.
 BASELINE_PRESET = "small"
 
 

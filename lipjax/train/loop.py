@@ -177,9 +177,10 @@ def train(
                             f"lower the learning rate or check the data."
                         )
                     now = time.perf_counter()
-                    rate = images / (now - t_last)
+                    rate = images / (now - t_last) if images else None  # None: only the compiling step ran
                     t_last, images = now, 0
-                    bar.set_postfix(loss=f"{metrics['loss']:.4g}", img_s=f"{rate:.1f}", phase=phase[:3])
+                    bar.set_postfix(loss=f"{metrics['loss']:.4g}", img_s="-" if rate is None else f"{rate:.1f}",
+                                    phase=phase[:3])
                     if log:
                         log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
                         log.flush()
