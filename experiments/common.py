@@ -121,6 +121,7 @@ def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequenc
         ax.plot(xs, ys, marker="o", label=name, linestyle="--" if "wavelet" in name else "-")
     if logx:
         ax.set_xscale("log")
+    ax.set_xticks(list(xs), [f"{x:g}" for x in xs])  # the measured points only (no 1.5 iterations, no 10^3 ticks)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title)

@@ -124,7 +124,8 @@ def main(argv=None) -> dict:
         lines += ["", f"Trained from scratch, {args.train_steps} steps each:", "",
                   "| K | MAE (m) |", "|---:|---:|"] + [f"| {k} | {v:.4f} |" for k, v in trained.items()]
         line_plot(out / "trained_k.png", ks, {"LIP+CNN trained with K iterations": list(trained.values())},
-                  xlabel="ADMM iterations K", ylabel="MAE (m)")
+                  xlabel="ADMM iterations K", ylabel="MAE (m)",
+                  title=f"synthetic {args.scene} test, {config.num_points} points, {args.train_steps} steps each")
     longest = max(len(c) for c in curves.values())
     line_plot(out / "convergence.png", list(range(longest)),
               {m: c + [np.nan] * (longest - len(c)) for m, c in curves.items()},
