@@ -4,6 +4,7 @@ Run by hand (never a test):
 
     .venv/bin/python benchmarks/baselines.py [--limit N] [--json out.json] [--realdata ../shared/realdata]
                                              [--skip-synthetic] [--skip-real] [--methods nearest,linear,...]
+                                             [--max-side N]
 
 Data sets (each a Markdown table: rows = methods, columns = metrics with units, lipjax.metrics):
   synthetic indoor test split, 256x320, 200 uniform points (UniformSampler(200)), depth range (0, 10] m;
@@ -120,6 +121,24 @@ class Setting:
     synthetic: bool = False  # --limit applies to synthetic splits only
 
 
+@dataclasses.dataclass
+class Downsized:
+    """A method run on the frame downsized to `max_side` (longer side), upsampled back with the measured pixels
+    re-imposed (lipjax.cli.complete_frame): e.g. real KITTI frames at the scale of the outdoor training renders."""
+
+    method: object
+    max_side: int
+
+    @property
+    def name(self) -> str:
+        return f"{self.method.name}@{self.max_side}"
+
+    def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
+        from lipjax.cli import complete_frame
+
+        return complete_frame(self.method, rgb, sparse, self.max_side)
+
+
 def run_setting(setting: Setting, methods, limit, progress: bool) -> dict:
     n = len(setting.dataset) if limit is None else min(limit, len(setting.dataset))
     points = [int((setting.sampler(setting.dataset[i], 0) > 0).sum()) for i in range(min(n, 5))]
@@ -145,10 +164,14 @@ def main(argv=None) -> None:
     ap.add_argument("--methods", default="nearest,linear,ip_basic,colorization,lip-wavelet",
                     help="comma-separated lipjax.methods names, e.g. add lip-cnn-indoor,lip-ad-indoor")
     ap.add_argument("--progress", action="store_true")
+    ap.add_argument("--max-side", type=int, default=None, metavar="N",
+                    help="run each method on frames downsized to this longer side, as `lipjax complete --max-side`")
     args = ap.parse_args(argv)
 
     wanted = args.methods.split(",")
     methods = [get_method(name) for name in wanted]  # any lipjax.methods name: classical, lip-wavelet, learned models
+    if args.max_side:
+        methods = [Downsized(m, args.max_side) for m in methods]
     print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIPWavelet()}")
 
     from lipjax.data import protocols

@@ -56,3 +56,34 @@ def test_output_depends_on_rgb_and_depth_once_head_is_nonzero():
 def test_unknown_preset_is_a_clear_error():
     with pytest.raises(ValueError, match="unknown network preset 'huge'"):
         network_preset("huge")
+
+
+def test_log_domain_prox_starts_as_the_identity_and_is_positive_for_any_weights(tmp_path):
+    import dataclasses
+
+    from lipjax import model_io
+    from lipjax.priors.network import LOG_DOMAIN_FLOOR, NetworkPrior
+
+    prior = dataclasses.replace(network_preset("tiny", max_depth_m=80.0), depth_domain="log")
+    params = prior.init(jax.random.key(0))
+    rng = np.random.default_rng(0)
+    v = jnp.asarray(rng.uniform(1.0, 79.0, (2, 16, 24)), jnp.float32)
+    rgb = jnp.asarray(rng.random((2, 16, 24, 3)), jnp.float32)
+    apply = jax.jit(prior.apply)
+    np.testing.assert_allclose(apply(params, v, rgb), v, rtol=1e-5)  # exp(log v + 0) = v
+    # Scrambled weights (head included) and inputs at or below zero: depth stays positive and finite, and the
+    # output is v times exp(residual), so an input below the floor starts from the floor.
+    keys = iter(jax.random.split(jax.random.key(1), 100))
+    wild = jax.tree_util.tree_map(lambda p: 3.0 * jax.random.normal(next(keys), p.shape), params)
+    v_bad = v.at[:, :4].set(-5.0).at[:, 4:6].set(0.0)
+    z = np.asarray(apply(wild, v_bad, rgb))
+    assert np.all(np.isfinite(z)) and np.all(z > 0)
+    assert np.any(np.abs(z - np.asarray(v_bad)) > 1.0)  # the scrambled net does change the depth
+    floor_m = LOG_DOMAIN_FLOOR * prior.max_depth_m
+    np.testing.assert_allclose(apply(params, v_bad, rgb)[:, :6], floor_m, rtol=1e-5)
+    # the option survives a model file, and a wrong name is a clear error
+    config = lip_model.LIPConfig(prior=prior, num_iterations=1)
+    model_io.save(tmp_path / "m", config, lip_model.init(config, jax.random.key(0)))
+    assert model_io.load(tmp_path / "m")[0].prior.depth_domain == "log"
+    with pytest.raises(ValueError, match="depth_domain"):
+        NetworkPrior(depth_domain="inverse")

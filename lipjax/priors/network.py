@@ -9,6 +9,8 @@ Architecture (early fusion encoder-decoder, paper Fig. 2):
     up2:   up-projection                             (H/2)  -> concat skip b1    (the paper's 2 skip connections)
     up3:   up-projection                             (H)
     head:  3x3 conv to 1 channel, zero-initialised, read as a residual on v in units of max_depth
+           (depth_domain="log": the input channel is log(v / max_depth) and the residual is added to it, so
+           z = v * exp(residual): a relative correction, and z > 0 whatever the network outputs)
 
 Choices and why:
 - Flax Linen applied functionally: the parameters are a plain pytree, so per-iteration networks are a `vmap` over
@@ -22,6 +24,9 @@ Choices and why:
   than a 5x5 transposed convolution.
 - Zero-initialised residual head: an untrained G is the identity, so an untrained LIP model returns its initial
   fill with the measurements kept, instead of noise.
+- The log domain is an option for outdoor scenes, where depth spans 1-80 m: an additive residual in units of
+  max_depth must be 10x finer at 8 m than at 80 m for the same relative error (what REL and the inverse-depth
+  metrics score), and nothing stops it from crossing zero (a few thin poles did, Design notes in the README).
 
 Units: v and z in metres; `max_depth_m` (10 m indoors, 80-90 m outdoors) only scales the network's inputs/outputs.
 """
@@ -34,6 +39,8 @@ import jax
 import jax.numpy as jnp
 
 DOWNSAMPLING = 8  # three stride-2 bottleneck blocks
+LOG_DOMAIN_FLOOR = 1e-3  # depth_domain="log": v is floored at this fraction of max_depth before the log
+DEPTH_DOMAINS = ("linear", "log")
 
 
 def _norm(channels: int) -> nn.GroupNorm:
@@ -83,6 +90,7 @@ class ProxNet(nn.Module):
     bottleneck_widths: tuple[int, int, int]
     up_widths: tuple[int, int, int]
     max_depth_m: float
+    depth_domain: str = "linear"
 
     @nn.compact
     def __call__(self, v, rgb):
@@ -91,6 +99,8 @@ class ProxNet(nn.Module):
         # Edge padding keeps the border statistics of the image; the padding is cropped off the output.
         pad = ((0, 0), (0, pad_h), (0, pad_w))
         d = jnp.pad(v, pad, mode="edge") / self.max_depth_m
+        if self.depth_domain == "log":
+            d = jnp.log(jnp.maximum(d, LOG_DOMAIN_FLOOR))
         c = jnp.pad(rgb, pad + ((0, 0),), mode="edge") - 0.5
         h = jnp.concatenate([d[..., None], c], axis=-1)
 
@@ -103,6 +113,9 @@ class ProxNet(nn.Module):
         u = UpProjection(self.up_widths[2])(jnp.concatenate([u, b1], axis=-1))
         residual = nn.Conv(1, (3, 3), kernel_init=nn.initializers.zeros)(u)[..., 0]
         z = d + residual
+        if self.depth_domain == "log":
+            # clip: exp of an early wild residual must not overflow; +-8 is a factor of 3000 either way
+            z = jnp.exp(d + jnp.clip(residual, -8.0, 8.0))
         return z[:, :height, :width] * self.max_depth_m
 
 
@@ -114,9 +127,15 @@ class NetworkPrior:
     bottleneck_widths: tuple[int, int, int] = (8, 16, 24)
     up_widths: tuple[int, int, int] = (32, 24, 16)
     max_depth_m: float = 10.0
+    depth_domain: str = "linear"  # "log": relative corrections, positive output (see the module docstring)
+
+    def __post_init__(self):
+        if self.depth_domain not in DEPTH_DOMAINS:
+            raise ValueError(f"depth_domain must be one of {DEPTH_DOMAINS}, got {self.depth_domain!r}")
 
     def module(self) -> ProxNet:
-        return ProxNet(self.stem_width, tuple(self.bottleneck_widths), tuple(self.up_widths), self.max_depth_m)
+        return ProxNet(self.stem_width, tuple(self.bottleneck_widths), tuple(self.up_widths), self.max_depth_m,
+                       self.depth_domain)
 
     def init(self, key: jax.Array, image_shape: tuple[int, int] = (64, 64), guidance_channels: int = 3):
         """Parameters for guidance images of `guidance_channels` channels (3 = RGB; the LIP model may add more)."""
