@@ -42,9 +42,9 @@ OUTDOOR_INITIAL_ESTIMATE = "nearest"
 
 
 def _model(max_depth_m: float, initial_estimate: str, preset: str = "small", iterations: int = 3,
-           output: str = "x") -> LIPConfig:
-    return LIPConfig(prior=network_preset(preset, max_depth_m=max_depth_m), num_iterations=iterations,
-                     initial_estimate=initial_estimate, output=output)
+           output: str = "x", depth_domain: str = "linear") -> LIPConfig:
+    prior = dataclasses.replace(network_preset(preset, max_depth_m=max_depth_m), depth_domain=depth_domain)
+    return LIPConfig(prior=prior, num_iterations=iterations, initial_estimate=initial_estimate, output=output)
 
 
 # The loss is L1, not the paper's L2: starting from the linear fill, L2 training raised the validation MAE
@@ -57,26 +57,20 @@ LIP_CNN_INDOOR = TrainConfig(
 # Outdoors the L1 depth loss alone left 123 validation pixels (in 10 of 32 frames) below 1 m, mostly negative (down
 # to -15 m against ~15 m truth): thin poles above the top LiDAR beam, in a region that is mostly sky and so
 # unsupervised. A handful of such pixels costs the depth loss nothing but ruins the inverse-depth metrics (val
-# iRMSE 4135 1/km against 13 for the nearest fill).
-# The inverse-depth term (lipjax.losses.inverse_depth_loss, in 1/m, floor 1 m) weighs them heavily and also
-# penalises depth below the floor where no ground truth exists. It left 2 such pixels in the 32 validation
-# frames (iRMSE 177 1/km), both made by the final dual step, whose output z_K - u_K = 2 z_K - x_K - u_{K-1}
-# overshot where the last prox moved its input by ~10 m. Reading the output from the last prox instead
-# (LIPConfig.output="z", runs/lip-cnn-outdoor-v5) did not help: the same poles came out of the prox itself
-# below 1 m (6 pixels, iRMSE 397 1/km; RMSE 4.35 m, MAE 1.26 m as with "x"), so the shipped model keeps "x".
+# iRMSE 4135 1/km against 13 for the nearest fill). What was tried, on the 32 val frames (RMSE m / iRMSE 1/km):
+#   + inverse-depth term (lipjax.losses.inverse_depth_loss, 1/m, floor 1 m; also penalises depth below the floor
+#     where there is no ground truth): 2 such pixels left, made by the final dual step's extrapolation
+#     z_K - u_K = 2 z_K - x_K - u_{K-1}: 4.344 / 177 (runs/lip-cnn-outdoor-v4, shipped in session 3);
+#   + output read from the last prox (LIPConfig.output="z"): the prox itself then made 6: 4.346 / 397 (v5);
+#   + inverse-depth weight 10, 30 or 100: no better on iRMSE at step 600 (12.7-12.8, as the weight 1 run at the
+#     same step before its bad pixels appeared) and worse on RMSE (5.10 against 4.50);
+#   + the prox in log depth (NetworkPrior.depth_domain="log": z = v * exp(residual), relative corrections) with the
+#     output read from the last prox: no depth <= 0 is possible any more, and it was better on every metric
+#     (runs/lip-cnn-outdoor-log). That is the shipped model.
 LIP_CNN_OUTDOOR = dataclasses.replace(
-    LIP_CNN_INDOOR, name="lip-cnn-outdoor", model=_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE),
+    LIP_CNN_INDOOR, name="lip-cnn-outdoor",
+    model=_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE, output="z", depth_domain="log"),
     data=OUTDOOR_DATA, g_steps=900, inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
-)
-# Experimental, not shipped: the outdoor LIP+CNN with its prox in log depth (z = v * exp(residual): relative
-# corrections, positive output) read out from the last prox (LIPConfig.output="z", no final dual extrapolation),
-# so the model cannot output depth <= 0. Aimed at the outdoor inverse-depth error (iRMSE), which the shipped model
-# loses to colourisation mostly at 8-80 m (benchmarks/inverse_depth_bands.py).
-LIP_CNN_OUTDOOR_LOG = dataclasses.replace(
-    LIP_CNN_OUTDOOR, name="lip-cnn-outdoor-log",
-    model=dataclasses.replace(
-        _model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE, output="z"),
-        prior=dataclasses.replace(network_preset("small", max_depth_m=OUTDOOR_MAX_DEPTH_M), depth_domain="log")),
 )
 # LIP+AD: start from the LIP+CNN model, pretrain D with G frozen, then train both (paper Sec. III-B).
 LIP_AD_INDOOR = dataclasses.replace(
@@ -127,7 +121,6 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_cnn_outdoor": LIP_CNN_OUTDOOR,
     "lip_ad_indoor": LIP_AD_INDOOR,
     "lip_ad_outdoor": LIP_AD_OUTDOOR,
-    "lip_cnn_outdoor_log": LIP_CNN_OUTDOOR_LOG,
     "smoke": SMOKE,
     **BASELINE_CONFIGS,
 }
