@@ -112,10 +112,11 @@ class ProxNet(nn.Module):
         u = UpProjection(self.up_widths[1])(jnp.concatenate([u, b2], axis=-1))
         u = UpProjection(self.up_widths[2])(jnp.concatenate([u, b1], axis=-1))
         residual = nn.Conv(1, (3, 3), kernel_init=nn.initializers.zeros)(u)[..., 0]
-        z = d + residual
         if self.depth_domain == "log":
             # clip: exp of an early wild residual must not overflow; +-8 is a factor of 3000 either way
             z = jnp.exp(d + jnp.clip(residual, -8.0, 8.0))
+        else:
+            z = d + residual
         return z[:, :height, :width] * self.max_depth_m
 
 
