@@ -62,8 +62,8 @@ LIP_CNN_INDOOR = TrainConfig(
 #     where there is no ground truth): 2 such pixels left, made by the final dual step's extrapolation
 #     z_K - u_K = 2 z_K - x_K - u_{K-1}: 4.344 / 177 (runs/lip-cnn-outdoor-v4, shipped in session 3);
 #   + output read from the last prox (LIPConfig.output="z"): the prox itself then made 6: 4.346 / 397 (v5);
-#   + inverse-depth weight 10, 30 or 100: no better on iRMSE at step 600 (12.7-12.8, as the weight 1 run at the
-#     same step before its bad pixels appeared) and worse on RMSE (5.10 against 4.50);
+#   + inverse-depth weight 10, 30 or 100 (stopped at steps 400-600): no better on iRMSE (12.7-12.8, against 12.5
+#     for weight 1 at step 600, before its bad pixels appeared) and worse on RMSE (5.10-5.11 against 4.50);
 #   + the prox in log depth (NetworkPrior.depth_domain="log": z = v * exp(residual), relative corrections) with the
 #     output read from the last prox: no depth <= 0 is possible any more, and it was better on every metric:
 #     4.115 / 11.9, MAE 1.148 m against 1.273 (runs/lip-cnn-outdoor-log). That is the shipped model.
