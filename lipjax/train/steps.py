@@ -69,7 +69,7 @@ def make_steps(config: TrainConfig) -> Steps:
         del key  # deterministic step; the argument keeps all steps interchangeable
         (loss, _), grads = jax.value_and_grad(g_supervised, has_aux=True)(state.g_params, batch)
         state = apply_g(state, grads)
-        metrics = {"loss": loss, "g_supervised_loss": loss, "g_grad_norm": optax.global_norm(grads)}
+        metrics = {"loss": loss, "g_supervised_loss": loss, "g_grad_norm": optax.tree_utils.tree_norm(grads)}
         return state.replace(step=state.step + 1), metrics
 
     def d_step_on(state, batch, fake):
@@ -103,7 +103,7 @@ def make_steps(config: TrainConfig) -> Steps:
         state = apply_g(state, grads)
         state, d_metrics = d_step_on(state, batch, fake)
         metrics = {"loss": loss, "g_supervised_loss": sup, "g_adversarial_loss": adv,
-                   "g_grad_norm": optax.global_norm(grads), **d_metrics}
+                   "g_grad_norm": optax.tree_utils.tree_norm(grads), **d_metrics}
         return state.replace(step=state.step + 1), metrics
 
     return Steps(
