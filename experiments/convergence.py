@@ -26,7 +26,7 @@ from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.inference import load_model
 from lipjax.metrics import MetricAggregator, compute_metrics
-from lipjax.model_io import available
+from lipjax.model_io import available, load
 from lipjax.utils import enable_compilation_cache
 
 
@@ -79,11 +79,9 @@ def train_k_models(scene: str, ks: list[int], steps: int, out: pathlib.Path) -> 
 
 def _finished(path: str, config) -> bool:
     """Whether `path` holds a model exported by a finished run of `config` (same model, same step budget)."""
-    from lipjax import model_io
-
     if not (pathlib.Path(path + ".json").exists() and pathlib.Path(path + ".msgpack").exists()):
         return False
-    model_config, _, metadata = model_io.load(path)
+    model_config, _, metadata = load(path)
     return (model_config == config.model and metadata.get("train_config") == config.name
             and metadata.get("steps") == config.total_steps)
 

@@ -51,11 +51,11 @@ class LIPConfig:
         mask and the fill's distance to the nearest sample, log2(1 + r) / 8 — with a dense z_0 the prox could
         otherwise not tell measured depth from extrapolated depth.
       output: how the estimate is read after the K iterations. "x": one more x-update with z_K - u_K (ADMM's
-        x-iterate; the paper, and every shipped model). "z": the x-update with z_K alone, i.e. the last prox's
-        estimate with the measurements re-imposed. Measured pixels keep the x-update's guarantee either way; on
-        the others "x" reads 2 z_K - x_K - u_{K-1}, which extrapolates the last prox's step (on the outdoor
-        model it turned 2 pixels where the last prox jumped by ~10 m into negative depth; trained with "z" the
-        model made as many bad pixels in its last prox instead, see experiments/configs.py).
+        x-iterate; the paper, and the shipped indoor models). "z": the x-update with z_K alone, i.e. the last
+        prox's estimate with the measurements re-imposed (the shipped outdoor models). Measured pixels keep the
+        x-update's guarantee either way; on the others "x" reads 2 z_K - x_K - u_{K-1}, which extrapolates the
+        last prox's step and can cross zero where that step is large. With a log-depth prox
+        (NetworkPrior.depth_domain="log") "z" makes depth <= 0 impossible; see experiments/configs.py.
     """
 
     prior: Any = dataclasses.field(default_factory=lambda: network_preset("small"))

@@ -170,7 +170,8 @@ def test_baseline_training_configs_copy_the_lip_runs():
         assert config.name == key.replace("_", "-")
         # only name and model differ, and the end-to-end networks train without the inverse-depth term
         assert config.inverse_depth_weight == 0.0
-        same = dataclasses.replace(config, name=lip.name, model=lip.model, inverse_depth_weight=lip.inverse_depth_weight)
+        same = dataclasses.replace(config, name=lip.name, model=lip.model,
+                                   inverse_depth_weight=lip.inverse_depth_weight)
         assert same == lip
         assert config.model.max_depth_m == lip.model.max_depth_m
         assert model_io.config_from_dict(model_io.config_to_dict(config.model)) == config.model
