@@ -2,6 +2,7 @@
 
 Parameters are a plain pytree:
     {"prox": <prior params, stacked (K, ...) per iteration or one shared set>,
+     "guidance_encoder": <params>,                 # only for a SharedEncoderPrior (run once per frame)
      "log_rho": (K,) float32}                      # only when rho is learned; rho = exp(log_rho) > 0
 
 Inputs and outputs (see `apply`): rgb (B, H, W, 3) uint8 or float in [0, 1]; sparse depth (B, H, W) float32 in
@@ -20,6 +21,7 @@ import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
 from lipjax.fill import box_fill_with_radius
+from lipjax.priors.base import SharedEncoderPrior
 from lipjax.priors.network import network_preset
 
 Params = Any
@@ -87,8 +89,8 @@ class LIPConfig:
         return {"z0": host_initial_estimate(self.initial_estimate, sparse)}
 
     def parameter_count(self, params) -> int:
-        """Learned network parameters (the prox networks of all iterations; rho excluded)."""
-        return parameter_count(params["prox"])
+        """Learned network parameters (the prox networks of all iterations and a shared encoder; rho excluded)."""
+        return parameter_count({k: v for k, v in params.items() if k != "log_rho"})
 
     @property
     def max_depth_m(self) -> float:
@@ -113,11 +115,15 @@ def init(config: LIPConfig, key: jax.Array) -> Params:
     # Parameter shapes never depend on the image size (fully convolutional priors); a small one keeps init cheap.
     channels = 5 if config.guidance == "rgb+mask" else 3
     init_one = functools.partial(config.prior.init, image_shape=(64, 64), guidance_channels=channels)
+    if isinstance(config.prior, SharedEncoderPrior):
+        key, encoder_key = jax.random.split(key)
     if config.shared_prox:
         prox = init_one(key)
     else:
         prox = jax.vmap(init_one)(jax.random.split(key, config.num_iterations))
     params = {"prox": prox}
+    if isinstance(config.prior, SharedEncoderPrior):
+        params["guidance_encoder"] = config.prior.init_encoder(encoder_key, guidance_channels=channels)
     if config.learn_rho:
         params["log_rho"] = jnp.full((config.num_iterations,), math.log(config.rho_init), jnp.float32)
     return params
@@ -176,6 +182,8 @@ def apply(
     if config.guidance == "rgb+mask":
         extra = [(weights > 0).astype(jnp.float32), jnp.log2(1.0 + radius) / 8.0]
         guidance = jnp.concatenate([guidance] + [e[..., None] for e in extra], axis=-1)
+    if isinstance(config.prior, SharedEncoderPrior):
+        guidance = config.prior.encode(params["guidance_encoder"], guidance, sparse, weights)  # once per frame
     return unrolled_admm(
         config.prior.apply,
         params["prox"],

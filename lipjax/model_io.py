@@ -23,9 +23,10 @@ WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
 
 
 def _prior_types() -> dict[str, type]:
+    from lipjax.priors.guided import GuidedPrior
     from lipjax.priors.wavelet import WaveletPrior
 
-    return {"network": NetworkPrior, "wavelet": WaveletPrior}
+    return {"network": NetworkPrior, "guided": GuidedPrior, "wavelet": WaveletPrior}
 
 
 def _model_types() -> dict[str, type]:

@@ -5,7 +5,8 @@ It knows nothing about the sampling operator A; the solver knows nothing about w
 """
 from __future__ import annotations
 
-from typing import Any, Protocol
+import abc
+from typing import Any, NamedTuple, Protocol
 
 import jax
 
@@ -28,3 +29,38 @@ class Prior(Protocol):
 
     def apply(self, params: Params, v: jax.Array, rgb: jax.Array) -> jax.Array:
         ...
+
+
+class EncodedGuidance(NamedTuple):
+    """What a `SharedEncoderPrior` computes once per frame and every iteration's prox reuses.
+
+    features: a tuple of (B, h, w, C) feature maps of the guidance image (any resolutions the prior chooses).
+    scale: (B, 1, 1) metres, the frame's depth scale (the median of its samples) that normalises the prox's input.
+    """
+
+    features: tuple
+    scale: jax.Array
+
+
+class SharedEncoderPrior(abc.ABC):
+    """A prior whose guidance image is encoded once per frame by a network shared by all K iterations.
+
+    The LIP model keeps the encoder's parameters beside the per-iteration ones ({"guidance_encoder": ...}) and
+    runs, once per frame, F = encode(encoder_params, guidance, y, m); then z_{k+1} = apply(params_k, x_{k+1} + u_k, F).
+    """
+
+    @abc.abstractmethod
+    def init_encoder(self, key: jax.Array, guidance_channels: int = 3) -> Params:
+        """Parameters of the shared guidance encoder."""
+
+    @abc.abstractmethod
+    def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> Params:
+        """Parameters of ONE iteration's prox (without the shared encoder)."""
+
+    @abc.abstractmethod
+    def encode(self, encoder_params: Params, guidance: jax.Array, y: jax.Array, weights: jax.Array) -> EncodedGuidance:
+        """guidance (B, H, W, C) in [0, 1], sparse depth y (B, H, W) metres and its weights -> EncodedGuidance."""
+
+    @abc.abstractmethod
+    def apply(self, params: Params, v: jax.Array, guidance: EncodedGuidance) -> jax.Array:
+        """z = prox(v, F): v (B, H, W) metres -> z (B, H, W) metres."""

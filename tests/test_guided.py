@@ -1,0 +1,122 @@
+"""The shared-encoder prox (lipjax.priors.guided): identity at init, scale equivariance, encoder run once."""
+import dataclasses
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from lipjax import model as lip_model
+from lipjax import model_io
+from lipjax.priors.guided import PRESETS, GuidedPrior, depth_to_space, sample_scale, space_to_depth
+
+TINY = PRESETS["tiny"]
+
+
+def _scramble(params, key=1, scale=0.3):
+    """Non-zero weights everywhere (the zero head would make every prox the identity)."""
+    leaves, tree = jax.tree_util.tree_flatten(params)
+    keys = jax.random.split(jax.random.key(key), len(leaves))
+    return jax.tree_util.tree_unflatten(tree, [scale * jax.random.normal(k, a.shape) for k, a in zip(keys, leaves)])
+
+
+def _frame(rng, shape=(2, 20, 28), n=30):
+    sparse = np.zeros(shape, np.float32)
+    for b in range(shape[0]):
+        idx = rng.choice(shape[1] * shape[2], n, replace=False)
+        sparse[b].reshape(-1)[idx] = rng.uniform(1.0, 6.0, n)
+    rgb = rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
+    return rgb, sparse
+
+
+def test_space_to_depth_round_trip_and_layout():
+    a = jnp.arange(2 * 4 * 6 * 3, dtype=jnp.float32).reshape(2, 4, 6, 3)
+    s = space_to_depth(a)
+    assert s.shape == (2, 2, 3, 12)
+    np.testing.assert_array_equal(s[0, 0, 0, :3], a[0, 0, 0])  # top-left pixel of the first 2x2 block
+    np.testing.assert_array_equal(s[0, 0, 0, 9:], a[0, 1, 1])  # bottom-right pixel of the same block
+    np.testing.assert_array_equal(depth_to_space(s), a)
+
+
+def test_sample_scale_is_the_geometric_mean_of_the_samples():
+    y = jnp.asarray([[[0.0, 2.0], [8.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]])
+    s = sample_scale(y, (y > 0).astype(jnp.float32))
+    np.testing.assert_allclose(s[:, 0, 0], [4.0, 1.0], rtol=1e-6)  # sqrt(2 * 8); no samples -> 1 m
+
+
+@pytest.mark.parametrize("shape", [(13, 21), (16, 24)])
+def test_untrained_prox_is_identity_at_any_size(shape):
+    rng = np.random.default_rng(0)
+    v = jnp.asarray(rng.uniform(0.5, 9.0, (2, *shape)), jnp.float32)
+    g = jnp.asarray(rng.random((2, *shape, 5)), jnp.float32)
+    enc = TINY.init_encoder(jax.random.key(0), guidance_channels=5)
+    params = TINY.init(jax.random.key(1), guidance_channels=5)
+    features = TINY.encode(enc, g, v, jnp.ones_like(v))
+    z = jax.jit(TINY.apply)(params, v, features)
+    assert z.shape == v.shape
+    np.testing.assert_allclose(z, v, rtol=1e-6)
+
+
+def _model(initial_estimate="linear", output="z"):
+    return lip_model.LIPConfig(prior=TINY, num_iterations=2, initial_estimate=initial_estimate, output=output)
+
+
+def test_lip_model_is_scale_equivariant():
+    """Input relative to the samples' scale and a relative correction: depth x c in gives depth x c out."""
+    config = _model()
+    params = _scramble(config.init(jax.random.key(0)))
+    params["log_rho"] = jnp.log(jnp.asarray([0.1, 0.2]))
+    rgb, sparse = _frame(np.random.default_rng(0))
+    run = jax.jit(lambda p, r, s, z0: config.apply(p, r, s, z0=z0)[0])
+    base = np.asarray(run(params, rgb, sparse, config.host_inputs(sparse)["z0"]))
+    for c in (0.1, 8.5):
+        scaled = np.asarray(run(params, rgb, c * sparse, config.host_inputs(c * sparse)["z0"]))
+        np.testing.assert_allclose(scaled, c * base, rtol=2e-4)
+    assert np.abs(base - config.host_inputs(sparse)["z0"]).max() > 1e-3  # the scrambled prox does change the fill
+
+
+def test_output_is_positive_for_any_weights_and_inputs():
+    config = _model(initial_estimate="sparse")
+    params = _scramble(config.init(jax.random.key(0)), scale=3.0)
+    rgb, sparse = _frame(np.random.default_rng(1))
+    out = np.asarray(jax.jit(lambda p, r, s: config.apply(p, r, s)[0])(params, rgb, sparse))
+    assert np.isfinite(out).all() and (out > 0).all()
+
+
+def test_encoder_is_shared_and_runs_once_per_frame():
+    config = _model()
+    params = config.init(jax.random.key(0))
+    assert set(params) == {"prox", "guidance_encoder", "log_rho"}
+    # per-iteration branches are stacked on a leading axis of size K; the encoder is not
+    assert all(a.shape[0] == 2 for a in jax.tree_util.tree_leaves(params["prox"]))
+    rgb, sparse = _frame(np.random.default_rng(2))
+    z0 = config.host_inputs(sparse)["z0"]
+    closed = jax.make_jaxpr(lambda p: config.apply(p, rgb, sparse, z0=z0)[0])(params)
+    scans = [e for e in closed.jaxpr.eqns if e.primitive.name == "scan"]
+    assert len(scans) == 1
+    in_loop = str(scans[0].params["jaxpr"]).count("conv_general_dilated")
+    total = str(closed).count("conv_general_dilated")
+    n_enc = sum(1 for a in jax.tree_util.tree_leaves(params["guidance_encoder"]) if a.ndim == 4)  # conv kernels
+    n_branch = sum(1 for a in jax.tree_util.tree_leaves(params["prox"]) if a.ndim == 5)  # (K, kh, kw, in, out)
+    assert in_loop == n_branch  # the loop body holds one depth branch and no encoder
+    assert total - in_loop == n_enc  # the encoder runs once, outside the loop
+
+
+def test_guided_model_survives_a_model_file(tmp_path):
+    config = _model()
+    params = _scramble(config.init(jax.random.key(0)))
+    model_io.save(tmp_path / "m", config, params)
+    config2, params2, _ = model_io.load(tmp_path / "m")
+    assert config2 == config
+    rgb, sparse = _frame(np.random.default_rng(3))
+    z0 = config.host_inputs(sparse)["z0"]
+    a = config.apply(params, rgb, sparse, z0=z0)[0]
+    b = config2.apply(params2, rgb, sparse, z0=z0)[0]
+    np.testing.assert_array_equal(a, b)
+
+
+def test_bad_widths_are_clear_errors():
+    with pytest.raises(ValueError, match="3 widths"):
+        GuidedPrior(encoder_widths=(8, 8))
+    with pytest.raises(ValueError, match="must agree"):
+        dataclasses.replace(TINY, branch_widths=(4, 16, 8))
