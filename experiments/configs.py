@@ -166,12 +166,24 @@ def _override(obj, path: list[str], text: str, key: str):
         value = _override(current, path[1:], text, key)
     elif dataclasses.is_dataclass(current):
         raise ValueError(f"config field {key!r} is a group; set one of its fields, e.g. {key}.<field>=...")
-    elif text == "None" or current is None:
-        value = None if text == "None" else text
-    elif isinstance(current, bool):  # bool("False") would be True
-        if text.lower() not in ("true", "false"):
-            raise ValueError(f"config field {key!r} takes true or false, not {text!r}")
-        value = text.lower() == "true"
     else:
-        value = type(current)(text)
+        value = _parse_value(text, str(fields[path[0]].type), current, key)
     return dataclasses.replace(obj, **{path[0]: value})
+
+
+def _parse_value(text: str, annotation: str, current, key: str):
+    """`text` as the type of a field: its current value's type, else the first type of its annotation."""
+    if text == "None":
+        return None
+    kind = type(current) if current is not None else annotation.split("|")[0].split("[")[0].strip()
+    try:
+        if kind in (bool, "bool"):  # bool("False") would be True
+            if text.lower() not in ("true", "false"):
+                raise ValueError
+            return text.lower() == "true"
+        if kind in (tuple, "tuple"):  # e.g. a crop: "128,160"
+            return tuple(int(v) for v in text.split(","))
+        return {"int": int, "float": float, "str": str}.get(kind, kind)(text)
+    except ValueError:
+        want = "true or false" if kind in (bool, "bool") else getattr(kind, "__name__", kind)
+        raise ValueError(f"config field {key!r} takes {want}, not {text!r}") from None

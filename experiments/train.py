@@ -36,7 +36,7 @@ def main(argv=None) -> None:
     p.add_argument("--config", required=True)
     p.add_argument("--workdir", default=None, help="default: runs/<config>")
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", help="override a config field")
-    p.add_argument("--export", default=None, help="model path stem (default: lipjax/weights/<name>)")
+    p.add_argument("--export", default=None, help="model path stem to export to (default: no export)")
     p.add_argument("--export-only", action="store_true", help="export the latest checkpoint without training")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
@@ -53,7 +53,11 @@ def main(argv=None) -> None:
     val = _final_validation(workdir / "metrics.jsonl", int(state.step))
     if val is None:  # not evaluated at this step by the loop (e.g. --export-only of an older checkpoint)
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
-    target = args.export or str(model_io.WEIGHTS_DIR / config.name)
+    if args.export is None:
+        print(f"[lipjax] trained {config.name} to step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f} "
+              "(add --export PATH to save a loadable model)")
+        return
+    target = args.export
     export(config, state, target, {"val_metrics": val, "val_sampler": config.data.val_sampler,
                                    "val_images": config.data.val_images, "data": config.data.kind})
     plot_curves(workdir / "metrics.jsonl", workdir / "curves.png", title=config.name)

@@ -384,6 +384,15 @@ def _cmd_train(argv: list[str]) -> int:
     return 0
 
 
+def _cmd_data_render(args) -> int:
+    from lipjax.data.rendered import render_to_disk
+
+    out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
+                         window=args.window, workers=args.workers, progress=not args.quiet)
+    print(f"rendered {args.count} {args.kind}/{args.split} frames to {out}")
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------- parsing
 
 
@@ -453,6 +462,20 @@ def build_parser() -> argparse.ArgumentParser:
 
     m = sub.add_parser("models", help="list the shipped models")
     m.set_defaults(func=_cmd_models)
+    d = sub.add_parser("data", help="data sets: `lipjax data render` writes the synthetic scenes to disk")
+    r = d.add_subparsers(dest="data_command", required=True, metavar="ACTION").add_parser(
+        "render", help="render synthetic frames into shard files (lipjax.data.rendered) in worker processes")
+    r.add_argument("--kind", required=True, choices=("indoor", "outdoor"))
+    r.add_argument("--split", default="train", choices=("train", "val", "test"))
+    r.add_argument("--count", type=_positive_int, required=True, help="frames 0 .. N-1 of the split")
+    r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
+    r.add_argument("--height", type=_positive_int, default=None, help="full frame (default 256x320 indoor, 128x416 outdoor)")
+    r.add_argument("--width", type=_positive_int, default=None)
+    r.add_argument("--window", type=_positive_int, nargs=2, default=None, metavar=("H", "W"),
+                   help="store one HxW window per frame, rendered directly at the training crop size")
+    r.add_argument("--workers", type=_positive_int, default=None, help="processes (default: every core)")
+    r.add_argument("--quiet", action="store_true")
+    r.set_defaults(func=_cmd_data_render)
     return parser
 
 

@@ -16,10 +16,16 @@ from lipjax.model import LIPConfig
 
 @dataclasses.dataclass(frozen=True)
 class DataConfig:
-    """The embedded synthetic data: scene kind, render size, training crop and the sparse samplers.
+    """Where the frames come from (lipjax.data.sources), the training crop and the sparse samplers.
 
-    Training batches are random crops of full-size renders, so that at test time (full size) the network sees
-    objects at the same pixel scale and the samples at the same density as in training.
+    source, root: one of lipjax.data.sources.SOURCES and its folder ("synthetic" needs none).
+    raw_root: KITTI raw drives for source kitti_dc (default: root). protocol: a lipjax.data.protocols name
+    (None: the source's default). depth_scale: PNG value per metre of a folder's depth (None: .npy metres).
+    kind, height, width: the synthetic scenes (sources synthetic and rendered; rendered validates on the
+    synthetic val split at this size). Training batches are random crops, so that at test time (full size)
+    the network sees objects at the same pixel scale and the samples at the same density as in training.
+    Samplers: lipjax.data.sampling specs, or "input[:N]" for the data set's own sparse input.
+    num_workers: loader worker processes (0: load in the training process).
     """
 
     kind: str = "indoor"
@@ -30,6 +36,11 @@ class DataConfig:
     val_sampler: str = "uniform:200"
     val_images: int = 32
     num_workers: int = 1
+    source: str = "synthetic"
+    root: str | None = None
+    raw_root: str | None = None
+    protocol: str | None = None
+    depth_scale: float | None = None
 
 
 @dataclasses.dataclass(frozen=True)

@@ -26,8 +26,8 @@ from lipjax import model_io
 from lipjax.checkpoint import CheckpointManager, to_host
 from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_batch
 from lipjax.data.sample import Batch
-from lipjax.data.sampling import example_rng, sampler_from_spec
-from lipjax.data.synthetic import SyntheticDataset
+from lipjax.data.sampling import example_rng
+from lipjax.data.sources import open_source
 from lipjax.inference import compiled_apply
 from lipjax.metrics import MetricAggregator, compute_metrics
 from lipjax.model import host_inputs_of
@@ -73,10 +73,9 @@ def with_host_inputs(model_config, batch: Batch) -> Batch:
 
 
 def validation_batches(config: TrainConfig) -> list[Batch]:
-    """The fixed validation set: the first `val_images` synthetic val frames at full size, with val_sampler."""
-    d = config.data
-    dataset = SyntheticDataset(d.kind, "val", size=d.val_images, height=d.height, width=d.width)
-    it = BatchIterator(dataset, min(EVAL_BATCH_SIZE, len(dataset)), sampler_from_spec(d.val_sampler), shuffle=False,
+    """The fixed validation set: the first `val_images` val frames of the source at full size, with val_sampler."""
+    source = open_source(config.data, "val")
+    it = BatchIterator(source.dataset, min(EVAL_BATCH_SIZE, len(source.dataset)), source.sampler, shuffle=False,
                        drop_last=False, num_epochs=1)
     return [with_host_inputs(config.model, b) for b in it]
 
@@ -147,8 +146,8 @@ def train(
 
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
     d = config.data
-    train_set = SyntheticDataset(d.kind, "train", height=d.height, width=d.width)
-    batches = BatchIterator(train_set, config.batch_size, sampler_from_spec(d.train_sampler), seed=config.seed,
+    source = open_source(d, "train")
+    batches = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
                             start_step=start, process_index=process_index, process_count=process_count,
                             num_workers=d.num_workers)
     log = open(workdir / "metrics.jsonl", "a") if is_main else None

@@ -1,0 +1,202 @@
+"""One factory for every data set training and evaluation read: `open_source(data_config, split)`.
+
+    source          root                                   default protocol   split
+    synthetic       (none: rendered on the fly)            none               the set's own train / val
+    rendered        a folder of `lipjax data render`       none               train: the folder; val: synthetic val
+    nyu_h5          nyudepthv2/ (Ma et al. h5 layout)      nyu_paper          train / val folders
+    nyu_tfds        TFDS data_dir (prepared ArrayRecord)   nyu_paper          train / validation
+    kitti_dc        depth_root (raw_root: KITTI raw)       kitti_paper        train / val folders
+    kitti_odometry  holds sequences/                       kitti_paper        last 5 % of each sequence is val
+    tartanair       holds the environment folders          tartanair          90 / 5 / 5 by trajectory
+    folder          rgb/ depth/ [sparse/], or train/ val/  none               train/ val/ if present, else the
+                                                                              last 5 % of the frames is val
+
+Sparse input: a sampler spec of lipjax.data.sampling ("uniform:200", "lidar:hdl64", mixtures "a|b"), or
+"input" / "input:N" for the data set's own sparse input: KITTI DC's real `velodyne_raw` scan, or a folder's
+sparse/<stem> maps (same format and depth scale as depth/); ":N" keeps exactly N of its points.
+
+Depth in metres throughout; `DataConfig` (lipjax.train.config) names the source, its root and the rest.
+"""
+from __future__ import annotations
+
+import dataclasses
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lipjax.data.errors import dataset_error
+from lipjax.data.protocols import ProtocolView, get_protocol
+from lipjax.data.sample import Sample
+from lipjax.data.sampling import SparseSampler, example_rng, sampler_from_spec, subsample_exact
+
+SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_odometry", "tartanair", "folder")
+DEFAULT_PROTOCOLS = {"nyu_h5": "nyu_paper", "nyu_tfds": "nyu_paper", "kitti_dc": "kitti_paper",
+                     "kitti_odometry": "kitti_paper", "tartanair": "tartanair"}
+VAL_TAIL_FRACTION = 0.05  # sources without a val split hold out the last 5 % of each sequence / folder
+OWN_INPUT = "input"
+
+
+@dataclasses.dataclass(frozen=True)
+class Source:
+    """A data set of (protocol-applied) Samples and the sampler that draws its sparse input."""
+
+    dataset: Any
+    sampler: SparseSampler
+
+
+class Subset:
+    """dataset[indices[i]] as an indexable data set (picklable when `dataset` is)."""
+
+    def __init__(self, dataset: Any, indices):
+        self.dataset, self.indices = dataset, np.asarray(indices, np.int64)
+
+    def __len__(self) -> int:
+        return len(self.indices)
+
+    def __getitem__(self, index: int) -> Sample:
+        return self.dataset[int(self.indices[index])]
+
+
+def tail_split(groups: list[str], split: str, fraction: float = VAL_TAIL_FRACTION) -> np.ndarray:
+    """Indices of `split` when each group (sequence) keeps its last `fraction` of frames (>= 1) for val.
+
+    groups: the group name of every frame, frames of a group in time order."""
+    names = np.asarray(groups)
+    val = np.zeros(len(names), bool)
+    for name in dict.fromkeys(groups):
+        where = np.flatnonzero(names == name)
+        val[where[len(where) - max(1, round(fraction * len(where))):]] = True
+    return np.flatnonzero(val if split == "val" else ~val)
+
+
+@dataclasses.dataclass(frozen=True)
+class FolderInput:
+    """Sampler: the folder's own sparse map <root>/sparse/<stem>.png|.npy (PNG: metres = value / depth_scale),
+    optionally sub-sampled to exactly num_points (keyed by the sample id). No protocol: folders train as is."""
+
+    directory: str
+    depth_scale: float | None
+    id_prefix: str
+    num_points: int | None = None
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        from lipjax.data.folder import read_depth
+
+        stem = sample.id[len(self.id_prefix) + 1:]
+        for suffix in (".png", ".npy"):
+            path = Path(self.directory) / f"{stem}{suffix}"
+            if path.is_file():
+                sparse = read_depth(path, self.depth_scale if suffix == ".png" else None)
+                break
+        else:
+            raise dataset_error(f"No sparse input for frame {stem!r} (sparse_input 'input' needs sparse/<stem>)",
+                                Path(self.directory) / f"{stem}.png")
+        if sparse.shape != sample.shape:
+            raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ", path)
+        if self.num_points is not None:
+            sparse = subsample_exact(sparse, self.num_points, example_rng(seed, sample.id))
+        return sparse
+
+
+def _own_points(spec: str) -> int | None:
+    _, _, n = spec.partition(":")
+    try:
+        return int(n) if n else None
+    except ValueError:
+        raise ValueError(f"sampler spec {spec!r}: expected 'input' or 'input:N' with an integer N") from None
+
+
+def _folder_root(root: Path, split: str) -> tuple[Path, bool]:
+    """(folder holding rgb/ and depth/ for this split, whether the split is a folder of its own)."""
+    if (root / "train").is_dir() and (root / "val").is_dir():
+        return root / split, True
+    return root, False
+
+
+def _raw_dataset(data: Any, split: str) -> tuple[Any, Any]:
+    """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
+    source, root = data.source, data.root
+    if source == "synthetic":
+        from lipjax.data.synthetic import SyntheticDataset
+
+        size = data.val_images if split == "val" else None
+        return SyntheticDataset(data.kind, split, size=size, height=data.height, width=data.width), None
+    if root is None:
+        raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")
+    if source == "rendered":
+        from lipjax.data.rendered import RenderedDataset
+        from lipjax.data.synthetic import SyntheticDataset
+
+        if split == "val":  # the fixed on-the-fly val set of the same kind: comparable across runs
+            return SyntheticDataset(data.kind, "val", size=data.val_images, height=data.height, width=data.width), None
+        dataset = RenderedDataset(root)
+        if dataset.kind != data.kind:
+            raise ValueError(f"{root} holds {dataset.kind} renders but data.kind={data.kind!r}; "
+                             f"add --set data.kind={dataset.kind}")
+        return dataset, None
+    if source == "nyu_h5":
+        from lipjax.data.nyu import NyuH5Dataset
+
+        return NyuH5Dataset(root, split), None
+    if source == "nyu_tfds":
+        from lipjax.data.nyu import NyuTfdsDataset
+
+        return NyuTfdsDataset(split, data_dir=root), None
+    if source == "kitti_dc":
+        from lipjax.data.kitti import KittiDepthCompletion
+
+        dataset = KittiDepthCompletion(root, data.raw_root or root, split)
+        return dataset, dataset
+    if source == "kitti_odometry":
+        from lipjax.data.kitti_odometry import KittiOdometry
+
+        dataset = KittiOdometry(root)
+        return Subset(dataset, tail_split([seq for seq, _, _ in dataset.frames], split)), None
+    if source == "tartanair":
+        from lipjax.data.tartanair import TartanAirDataset
+
+        return TartanAirDataset(root, split), None
+    if source == "folder":
+        from lipjax.data.folder import FolderDataset
+
+        folder, own_split = _folder_root(Path(root), split)
+        dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}")
+        own = FolderInput(os.fspath(folder / "sparse"), data.depth_scale, dataset.id_prefix)
+        if own_split:
+            return dataset, own
+        return Subset(dataset, tail_split(["all"] * len(dataset), split)), own
+    raise ValueError(f"unknown data.source {source!r}; choose one of {SOURCES}")
+
+
+def open_source(data: Any, split: str) -> Source:
+    """The Source of a DataConfig's `split` ("train" or "val"): protocol applied, val cut to val_images frames.
+
+    The train split uses data.train_sampler, val data.val_sampler (see the module docstring for "input").
+    """
+    if split not in ("train", "val"):
+        raise ValueError(f"split must be 'train' or 'val', got {split!r}")
+    dataset, own = _raw_dataset(data, split)
+    protocol_name = data.protocol or DEFAULT_PROTOCOLS.get(data.source)
+    protocol = get_protocol(protocol_name) if protocol_name else None
+    spec = data.train_sampler if split == "train" else data.val_sampler
+    if spec.split(":")[0].strip() == OWN_INPUT:
+        if own is None:
+            raise ValueError(f"sampler {spec!r}: data.source={data.source!r} has no sparse input of its own; "
+                             "use a spec such as uniform:200")
+        if data.source == "kitti_dc":
+            from lipjax.data.kitti import KittiLidarInput
+
+            sampler = KittiLidarInput(own, protocol, _own_points(spec))
+        else:
+            sampler = dataclasses.replace(own, num_points=_own_points(spec))
+    else:
+        sampler = sampler_from_spec(spec)
+    if protocol is not None:
+        dataset = ProtocolView(dataset, protocol)
+    if split == "val" and data.source != "synthetic" and len(dataset) > data.val_images:
+        dataset = Subset(dataset, np.arange(data.val_images))
+    if len(dataset) == 0:
+        raise ValueError(f"data.source={data.source!r} at {data.root}: the {split} split is empty")
+    return Source(dataset, sampler)
