@@ -2,7 +2,8 @@
 
     get_method("lip-ad-indoor")       shipped LIP model (lipjax/weights), or any saved model path
     get_method("lip-wavelet")         LIP with the hand-crafted wavelet soft-thresholding prox (no training)
-    get_method("colorization")        classical fills: nearest, linear, ip_basic, colorization
+    get_method("colorization")        classical fills: nearest, linear, ip_basic, ip_basic_multiscale,
+                                      ip_basic_adaptive, colorization
 
 All are `DepthCompleter`s: completer(rgb (H,W,3) uint8, sparse (H,W) float32 metres) -> (H,W) float32 m, with
 a `name`.

@@ -2,11 +2,14 @@
 
     completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
-  NearestFill        nearest sample (Voronoi), exact at samples                  ignores RGB   nearest.py
-  LinearFill         Delaunay piecewise-linear, nearest outside the hull         ignores RGB   interpolate.py
-  IPBasicFill        IP-Basic morphological fill (Ku et al. 2018)                ignores RGB   ipbasic.py
-  ColorizationFill   Levin et al. 2004 colourisation (NYU toolbox), exact at     RGB-guided    colorization.py
-                     samples
+  NearestFill             nearest sample (Voronoi), exact at samples                ignores RGB   nearest.py
+  LinearFill              Delaunay piecewise-linear, nearest outside the hull       ignores RGB   interpolate.py
+  IPBasicFill             IP-Basic `fill_in_fast` (Ku et al. 2018); 0 where it      ignores RGB   ipbasic.py
+                          leaves no depth
+  IPBasicMultiscaleFill   IP-Basic `fill_in_multiscale`; 0 where it leaves no depth ignores RGB   ipbasic.py
+  IPBasicAdaptiveFill     IP-Basic with density-adaptive kernels, fills every pixel ignores RGB   ipbasic.py
+  ColorizationFill        Levin et al. 2004 colourisation (NYU toolbox), exact at   RGB-guided    colorization.py
+                          samples
 
 Each raises ValueError for an empty sparse map, mismatched shapes, NaN / inf or negative depth. The LIP+Wavelet
 baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
@@ -16,7 +19,14 @@ from __future__ import annotations
 from lipjax.baselines.colorization import ColorizationFill, colorization_fill
 from lipjax.baselines.completer import BatchFnCompleter, DepthCompleter
 from lipjax.baselines.interpolate import LinearFill, linear_fill
-from lipjax.baselines.ipbasic import IPBasicFill, ipbasic_fill
+from lipjax.baselines.ipbasic import (
+    IPBasicAdaptiveFill,
+    IPBasicFill,
+    IPBasicMultiscaleFill,
+    ip_basic,
+    ip_basic_adaptive,
+    ip_basic_multiscale,
+)
 from lipjax.baselines.nearest import NearestFill, nearest_fill
 from lipjax.inputs import check_frame
 
@@ -24,18 +34,23 @@ __all__ = [
     "BatchFnCompleter",
     "ColorizationFill",
     "DepthCompleter",
+    "IPBasicAdaptiveFill",
     "IPBasicFill",
+    "IPBasicMultiscaleFill",
     "LinearFill",
     "NearestFill",
     "check_frame",
     "classical_completers",
     "colorization_fill",
-    "ipbasic_fill",
+    "ip_basic",
+    "ip_basic_adaptive",
+    "ip_basic_multiscale",
     "linear_fill",
     "nearest_fill",
 ]
 
 
 def classical_completers() -> list[DepthCompleter]:
-    """One instance of each classical completer with its default (density-adaptive) parameters."""
-    return [NearestFill(), LinearFill(), IPBasicFill(), ColorizationFill()]
+    """One instance of each classical completer with its default parameters."""
+    return [NearestFill(), LinearFill(), IPBasicFill(), IPBasicMultiscaleFill(), IPBasicAdaptiveFill(),
+            ColorizationFill()]

@@ -1,16 +1,25 @@
-"""Classical completers by name, for configs and command lines: `make_completer("ip_basic", radius_px=5)`."""
+"""Classical completers by name, for configs and command lines: `make_completer("ip_basic", extrapolate=True)`."""
 from __future__ import annotations
 
 from collections.abc import Callable
 from typing import Any
 
-from lipjax.baselines.classical import ColorizationFill, IPBasicFill, LinearFill, NearestFill
+from lipjax.baselines.classical import (
+    ColorizationFill,
+    IPBasicAdaptiveFill,
+    IPBasicFill,
+    IPBasicMultiscaleFill,
+    LinearFill,
+    NearestFill,
+)
 from lipjax.baselines.completer import DepthCompleter
 
 COMPLETERS: dict[str, Callable[..., DepthCompleter]] = {
     "nearest": NearestFill,
     "linear": LinearFill,
     "ip_basic": IPBasicFill,
+    "ip_basic_multiscale": IPBasicMultiscaleFill,
+    "ip_basic_adaptive": IPBasicAdaptiveFill,
     "colorization": ColorizationFill,
 }
 
