@@ -1,0 +1,155 @@
+"""Training-time augmentation of a batch: random zoomed crop, flip, photometric jitter, blur, sensor noise, outliers.
+
+    batch = augment_batch(batch, Augment(...), seed, step, first_example)
+
+Every random draw comes from `example_rng(seed, f"augment/{step}/{i}")` with i the example's index in the global
+batch, so an augmented batch is a pure function of (seed, step) whatever the process split (resumable runs).
+
+What each part is for (real sensors and real frames differ from the synthetic renders in these ways):
+- zoomed crop: a crop window of (ch / s, cw / s) pixels resized to (ch, cw), s drawn log-uniformly in `zoom`,
+  so the prox sees objects at several pixel sizes and samples at several densities (frames larger or smaller
+  than the training renders, e.g. full-size KITTI or Middlebury). RGB is resized with area / bilinear
+  interpolation, ground truth by nearest neighbour (depths are never averaged across edges), and every sparse
+  sample moves to the pixel of the new grid it falls in, the nearest depth winning where several meet.
+- horizontal flip (geometry stays valid for a pinhole camera; the scenes have no left/right bias);
+- photometric jitter: brightness, contrast and saturation factors in [1 - a, 1 + a] and gamma in
+  [1 / (1 + g), 1 + g] (camera exposure, white balance, tone curves);
+- Gaussian blur with probability `blur_prob`, sigma up to `blur_sigma_px` pixels (defocus, motion, JPEG);
+- sensor noise: every sample's depth times (1 + n), n ~ N(0, depth_noise) (LiDAR range noise is roughly
+  proportional to range at these scales);
+- outliers: a fraction of the samples pushed behind their true depth by a factor in [1.1, 3] (the LiDAR and the
+  camera see an edge from different viewpoints, so some returns come from the background: "bleed-through").
+Ground truth is only cropped, zoomed and flipped: the model learns to undo the noise and the outliers.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import cv2
+import numpy as np
+
+from lipjax.data.sample import Batch
+from lipjax.data.sampling import example_rng
+
+OUTLIER_FACTOR = (1.1, 3.0)  # depth multipliers of a bleed-through outlier
+
+
+@dataclasses.dataclass(frozen=True)
+class Augment:
+    """Augmentation settings (dimensionless unless named). The defaults change nothing but the crop position."""
+
+    zoom: tuple[float, float] = (1.0, 1.0)
+    hflip: bool = False
+    brightness: float = 0.0
+    contrast: float = 0.0
+    saturation: float = 0.0
+    gamma: float = 0.0
+    blur_prob: float = 0.0
+    blur_sigma_px: float = 1.5
+    depth_noise: float = 0.0
+    outlier_fraction: float = 0.0
+
+    def __post_init__(self):
+        lo, hi = self.zoom
+        if not 0 < lo <= hi:
+            raise ValueError(f"zoom must be (min, max) with 0 < min <= max, got {self.zoom}")
+        for name in ("brightness", "contrast", "saturation"):
+            if not 0 <= getattr(self, name) < 1:
+                raise ValueError(f"{name} must be in [0, 1), got {getattr(self, name)}")
+        if not (0 <= self.blur_prob <= 1 and 0 <= self.outlier_fraction <= 1):
+            raise ValueError("blur_prob and outlier_fraction are probabilities in [0, 1]")
+        if self.gamma < 0 or self.depth_noise < 0 or self.blur_sigma_px <= 0:
+            raise ValueError("gamma and depth_noise must be >= 0 and blur_sigma_px > 0")
+
+
+# The settings the shipped fast models train with.
+DEFAULT_TRAINING = Augment(zoom=(0.75, 1.33), hflip=True, brightness=0.2, contrast=0.2, saturation=0.2, gamma=0.2,
+                           blur_prob=0.2, depth_noise=0.005, outlier_fraction=0.01)
+
+
+def move_samples(sparse: np.ndarray, top: float, left: float, scale: float, shape: tuple[int, int]) -> np.ndarray:
+    """Sparse depth (H, W) metres -> the window's samples on a (h, w) grid scaled by `scale` (new px per old px).
+
+    A sample at pixel centre (r + 0.5, c + 0.5) lands in the new pixel floor((r + 0.5 - top) * scale), likewise
+    for columns; samples outside the grid are dropped; where several land in one pixel the nearest wins.
+    """
+    h, w = shape
+    rows, cols = np.nonzero(sparse > 0)
+    nr = np.floor((rows + 0.5 - top) * scale).astype(np.int64)
+    nc = np.floor((cols + 0.5 - left) * scale).astype(np.int64)
+    keep = (nr >= 0) & (nr < h) & (nc >= 0) & (nc < w)
+    depth = sparse[rows[keep], cols[keep]]
+    out = np.full((h, w), np.inf, np.float32)
+    np.minimum.at(out, (nr[keep], nc[keep]), depth)
+    return np.where(np.isfinite(out), out, 0.0).astype(np.float32)
+
+
+def _zoomed_crop(rgb, sparse, gt, valid, crop: tuple[int, int], scale: float, rng: np.random.Generator):
+    ch, cw = crop
+    h, w = gt.shape
+    scale = max(scale, ch / h, cw / w)  # the window (ch / scale, cw / scale) must fit in the frame
+    top = int(rng.integers(0, int(np.floor(h - ch / scale)) + 1))
+    left = int(rng.integers(0, int(np.floor(w - cw / scale)) + 1))
+    if scale == 1.0:
+        window = (slice(top, top + ch), slice(left, left + cw))
+        return rgb[window], sparse[window], gt[window], valid[window]
+    # new pixel centre (x + 0.5) sits at old coordinate (x + 0.5) / scale + left, i.e. pixel (x + 0.5) / scale
+    # + left - 0.5 in OpenCV's pixel-centre convention; bilinear for RGB (zoom within 0.75-1.33: little aliasing)
+    m = np.array([[1 / scale, 0, left + 0.5 / scale - 0.5], [0, 1 / scale, top + 0.5 / scale - 0.5]])
+    warp = cv2.WARP_INVERSE_MAP
+    new_rgb = cv2.warpAffine(rgb, m, (cw, ch), flags=cv2.INTER_LINEAR | warp, borderMode=cv2.BORDER_REFLECT)
+    new_gt = cv2.warpAffine(gt, m, (cw, ch), flags=cv2.INTER_NEAREST | warp, borderValue=0)
+    new_valid = cv2.warpAffine(valid.astype(np.uint8), m, (cw, ch), flags=cv2.INTER_NEAREST | warp, borderValue=0)
+    return new_rgb, move_samples(sparse, top, left, scale, crop), new_gt, new_valid.astype(bool)
+
+
+def photometric(rgb: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.ndarray:
+    """(H, W, 3) uint8 -> uint8 with random brightness, contrast, saturation and gamma (see the module doc)."""
+    x = rgb.astype(np.float32) / 255.0
+    x = x * rng.uniform(1 - aug.brightness, 1 + aug.brightness)
+    mean = x.mean()
+    x = (x - mean) * rng.uniform(1 - aug.contrast, 1 + aug.contrast) + mean
+    grey = x.mean(axis=-1, keepdims=True)
+    x = (x - grey) * rng.uniform(1 - aug.saturation, 1 + aug.saturation) + grey
+    x = np.clip(x, 0.0, 1.0) ** np.exp(rng.uniform(-1, 1) * np.log1p(aug.gamma))
+    return np.round(x * 255.0).astype(np.uint8)
+
+
+def perturb_samples(sparse: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.ndarray:
+    """Sensor noise and bleed-through outliers on the samples of (H, W) sparse depth in metres (0 stays 0)."""
+    out = sparse.copy()
+    idx = np.flatnonzero(out > 0)
+    flat = out.reshape(-1)
+    if aug.depth_noise > 0:
+        flat[idx] *= np.maximum(1.0 + aug.depth_noise * rng.standard_normal(idx.size), 0.5).astype(np.float32)
+    if aug.outlier_fraction > 0 and idx.size:
+        bad = idx[rng.random(idx.size) < aug.outlier_fraction]
+        flat[bad] *= rng.uniform(*OUTLIER_FACTOR, bad.size).astype(np.float32)
+    return out
+
+
+def augment_example(rgb, sparse, gt, valid, crop, aug: Augment, rng: np.random.Generator):
+    """One example's (rgb, sparse, gt, valid) -> augmented and cropped to `crop` (None: the full frame)."""
+    lo, hi = aug.zoom
+    scale = float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+    crop = crop or gt.shape
+    rgb, sparse, gt, valid = _zoomed_crop(rgb, sparse, gt, valid, crop, scale, rng)
+    if aug.hflip and rng.random() < 0.5:
+        rgb, sparse, gt, valid = (a[:, ::-1] for a in (rgb, sparse, gt, valid))
+    if aug.brightness or aug.contrast or aug.saturation or aug.gamma:
+        rgb = photometric(rgb, aug, rng)
+    if aug.blur_prob and rng.random() < aug.blur_prob:
+        rgb = cv2.GaussianBlur(np.ascontiguousarray(rgb), (0, 0), rng.uniform(0.3, aug.blur_sigma_px))
+    if aug.depth_noise or aug.outlier_fraction:
+        sparse = perturb_samples(sparse, aug, rng)
+    return tuple(np.ascontiguousarray(a) for a in (rgb, sparse, gt, valid))
+
+
+def augment_batch(batch: Batch, aug: Augment, crop: tuple[int, int] | None, seed: int, step: int,
+                  first_example: int = 0) -> Batch:
+    """Augments and crops every example of a batch (see the module docstring); keyed by (seed, step, example)."""
+    examples = [augment_example(batch.rgb[i], batch.sparse[i], batch.gt[i], batch.gt_valid[i], crop, aug,
+                                example_rng(seed, f"augment/{step}/{first_example + i}"))
+                for i in range(len(batch.gt))]
+    rgb, sparse, gt, valid = (np.stack(a) for a in zip(*examples))
+    return Batch(rgb=rgb, sparse=sparse, gt=gt, gt_valid=valid)

@@ -1,0 +1,93 @@
+"""Training augmentation (lipjax.data.augment): geometry of the zoomed crop, determinism, noise statistics."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from lipjax.data.augment import DEFAULT_TRAINING, Augment, augment_batch, move_samples, perturb_samples, photometric
+from lipjax.data.sample import Batch
+
+
+def _batch(n=4, h=40, w=48, seed=0):
+    rng = np.random.default_rng(seed)
+    gt = rng.uniform(1.0, 9.0, (n, h, w)).astype(np.float32)
+    sparse = np.where(rng.random((n, h, w)) < 0.1, gt, 0.0).astype(np.float32)
+    rgb = rng.integers(0, 256, (n, h, w, 3), dtype=np.uint8)
+    return Batch(rgb=rgb, sparse=sparse, gt=gt, gt_valid=np.ones((n, h, w), bool))
+
+
+def test_no_augmentation_is_a_plain_crop():
+    b = _batch()
+    out = augment_batch(b, Augment(), (16, 24), seed=0, step=3)
+    assert out.rgb.shape == (4, 16, 24, 3) and out.sparse.shape == (4, 16, 24)
+    for i in range(4):  # each example is a window of its frame, the same window for every array
+        hits = [(t, l) for t in range(25) for l in range(25) if np.array_equal(out.gt[i], b.gt[i, t:t + 16, l:l + 24])]
+        assert len(hits) == 1
+        t, l = hits[0]
+        np.testing.assert_array_equal(out.rgb[i], b.rgb[i, t:t + 16, l:l + 24])
+        np.testing.assert_array_equal(out.sparse[i], b.sparse[i, t:t + 16, l:l + 24])
+
+
+@pytest.mark.parametrize("zoom", [1.3, 0.8])
+def test_zoomed_samples_land_on_their_own_ground_truth(zoom):
+    """Every moved sample sits on a pixel whose (nearest-neighbour) ground truth is within the sample's pixel."""
+    b = _batch(n=3, h=60, w=64)
+    aug = Augment(zoom=(zoom, zoom))
+    out = augment_batch(b, aug, (32, 40), seed=1, step=0)
+    measured = out.sparse > 0
+    assert measured.sum() > 20
+    if zoom > 1:  # one old pixel covers several new ones: the sample lands inside its own pixel's footprint
+        np.testing.assert_array_equal(out.sparse[measured], out.gt[measured])
+    else:  # several old pixels share one new pixel: the sample is one of them, the nearest depth wins
+        assert np.mean(out.sparse[measured] == out.gt[measured]) > 0.2
+
+
+def test_move_samples_keeps_the_nearest_where_samples_collide():
+    sparse = np.zeros((4, 4), np.float32)
+    sparse[0, 0], sparse[0, 1], sparse[3, 3] = 5.0, 2.0, 7.0
+    out = move_samples(sparse, top=0, left=0, scale=0.5, shape=(2, 2))
+    np.testing.assert_array_equal(out, [[2.0, 0.0], [0.0, 7.0]])
+
+
+def test_augmentation_is_a_pure_function_of_seed_step_and_example_index():
+    b = _batch()
+    a1 = augment_batch(b, DEFAULT_TRAINING, (16, 24), seed=5, step=7)
+    a2 = augment_batch(b, DEFAULT_TRAINING, (16, 24), seed=5, step=7)
+    for f in ("rgb", "sparse", "gt", "gt_valid"):
+        np.testing.assert_array_equal(getattr(a1, f), getattr(a2, f))
+    # a process that holds examples 2..3 of the global batch augments them exactly as the single process did
+    half = Batch(*(getattr(b, f)[2:] for f in ("rgb", "sparse", "gt", "gt_valid")))
+    a3 = augment_batch(half, DEFAULT_TRAINING, (16, 24), seed=5, step=7, first_example=2)
+    np.testing.assert_array_equal(a3.sparse, a1.sparse[2:])
+    a4 = augment_batch(b, DEFAULT_TRAINING, (16, 24), seed=5, step=8)
+    assert not np.array_equal(a4.rgb, a1.rgb)
+
+
+def test_photometric_identity_and_range():
+    rgb = np.random.default_rng(0).integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    rng = np.random.default_rng(0)
+    np.testing.assert_array_equal(photometric(rgb, Augment(), rng), rgb)
+    out = photometric(rgb, Augment(brightness=0.5, contrast=0.5, saturation=0.5, gamma=1.0), rng)
+    assert out.dtype == np.uint8 and not np.array_equal(out, rgb)
+
+
+def test_sensor_noise_is_relative_and_outliers_only_push_samples_back():
+    rng = np.random.default_rng(0)
+    sparse = np.where(rng.random((200, 200)) < 0.5, rng.uniform(1, 50, (200, 200)), 0).astype(np.float32)
+    noisy = perturb_samples(sparse, Augment(depth_noise=0.02), np.random.default_rng(1))
+    m = sparse > 0
+    np.testing.assert_array_equal(noisy[~m], 0.0)
+    rel = noisy[m] / sparse[m] - 1
+    assert abs(rel.std() - 0.02) < 0.002 and abs(rel.mean()) < 0.001
+    out = perturb_samples(sparse, Augment(outlier_fraction=0.1), np.random.default_rng(2))
+    ratio = out[m] / sparse[m]
+    moved = ratio != 1
+    assert abs(moved.mean() - 0.1) < 0.01
+    assert ratio[moved].min() >= 1.1 and ratio[moved].max() <= 3.0
+
+
+def test_bad_settings_are_clear_errors():
+    with pytest.raises(ValueError, match="zoom"):
+        Augment(zoom=(1.5, 1.0))
+    with pytest.raises(ValueError, match="brightness"):
+        dataclasses.replace(DEFAULT_TRAINING, brightness=1.5)
