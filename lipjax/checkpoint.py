@@ -3,11 +3,17 @@
 Each checkpoint is a step folder written by orbax to a temporary name and renamed when complete, so a run killed
 at any moment leaves only whole checkpoints; the last `keep` are kept. The state is stored as its state dict
 (`flax.serialization.to_state_dict`): plain nested dicts of arrays, restored into a template of the same structure.
+
+A checkpoint damaged afterwards (a truncated or lost file) does not block resuming: `restore` reports it in one
+line on stderr, moves it to `<directory>-unreadable/<step>` (nothing is deleted) and restores the newest one that
+does restore. When none does, it raises CheckpointError, whose one-line message names the folder to move away.
 """
 from __future__ import annotations
 
 import os
 import pathlib
+import shutil
+import sys
 from typing import Any
 
 import flax.serialization
@@ -22,6 +28,16 @@ def to_host(a) -> np.ndarray:
     if isinstance(a, jax.Array) and not a.is_fully_addressable:
         return np.asarray(a.addressable_data(0))
     return np.asarray(a)
+
+
+class CheckpointError(ValueError):
+    """No checkpoint of a run restores; the message (one line) names the folder to move away."""
+
+
+def _first_line(exc: BaseException, limit: int = 160) -> str:
+    text = next((line.strip() for line in str(exc).splitlines() if line.strip()), "")
+    text = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 class CheckpointManager:
@@ -48,15 +64,48 @@ class CheckpointManager:
         self._manager.wait_until_finished()
 
     def restore(self, template: Any, step: int | None = None) -> tuple[Any, dict]:
-        """(state with template's structure, metadata) of `step` (default: the latest)."""
-        step = self.latest_step() if step is None else step
-        if step is None:
+        """(state with template's structure, metadata) of `step`, or by default of the newest checkpoint that
+        restores: newer ones that do not are reported and moved aside (see the module docstring)."""
+        if step is not None:
+            return self._restore(template, step)
+        steps = sorted(self.all_steps(), reverse=True)
+        if not steps:
             raise FileNotFoundError(f"no checkpoint in {self.directory}")
+        failures = []
+        for candidate in steps:
+            try:
+                restored = self._restore(template, candidate)
+            except Exception as exc:  # noqa: BLE001 - any failure to read a checkpoint means it is unusable
+                failures.append((candidate, exc))
+                continue
+            for bad, exc in failures:
+                moved = self._set_aside(bad)
+                print(f"lipjax: warning: checkpoint step {bad} in {self.directory} does not restore "
+                      f"({_first_line(exc)}); moved it to {moved}; resuming from step {candidate}", file=sys.stderr)
+            return restored
+        raise CheckpointError(
+            f"no checkpoint in {self.directory} restores (step {steps[0]}: {_first_line(failures[0][1])}); "
+            f"move {self.directory} away (or use another workdir) to start the run afresh"
+        )
+
+    def _restore(self, template: Any, step: int) -> tuple[Any, dict]:
         target = jax.tree_util.tree_map(np.asarray, flax.serialization.to_state_dict(template))
         restored = self._manager.restore(
             step, args=ocp.args.Composite(state=ocp.args.PyTreeRestore(target), meta=ocp.args.JsonRestore())
         )
         return flax.serialization.from_state_dict(template, restored["state"]), restored["meta"]
+
+    def _set_aside(self, step: int) -> pathlib.Path:
+        """Moves the step folder to <directory>-unreadable/<step>[.n] (the main process only); returns where."""
+        aside = self.directory.with_name(self.directory.name + "-unreadable")
+        target, n = aside / str(step), 1
+        while target.exists():
+            target, n = aside / f"{step}.{n}", n + 1
+        if jax.process_index() == 0:
+            aside.mkdir(exist_ok=True)
+            shutil.move(self.directory / str(step), target)
+        self._manager.reload()
+        return target
 
     def close(self) -> None:
         self._manager.close()
