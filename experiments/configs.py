@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 
 from lipjax.baselines.networks import baseline_preset
+from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.discriminator import Discriminator
 from lipjax.model import LIPConfig
 from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
@@ -118,9 +119,12 @@ BASELINE_CONFIGS: dict[str, TrainConfig] = {
 }
 
 # The shared-encoder prox (lipjax.priors.guided): ~3x cheaper per frame than the paper-style G above, so it can
-# train ~3x longer for the same CPU time. Started from the linear fill (identity-initialised), L1 loss.
+# train ~3x longer for the same CPU time. Started from the linear fill (identity-initialised), L1 loss, with the
+# augmentation real sensors need (lipjax.data.augment.DEFAULT_TRAINING). Reads pre-rendered frames when given
+# --set data.source=rendered --set data.root=DIR (`lipjax data render`), else renders on the fly.
 LIP_FAST_INDOOR = dataclasses.replace(
     LIP_CNN_INDOOR, name="lip-fast-indoor", model=_fast_model(INDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE),
+    data=dataclasses.replace(INDOOR_DATA, augment=DEFAULT_AUGMENT),
     g_steps=8000, learning_rate=1e-3, warmup_steps=200, eval_every=500, checkpoint_every=100,
 )
 

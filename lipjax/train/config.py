@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 
+from lipjax.data.augment import Augment
 from lipjax.discriminator import Discriminator
 from lipjax.model import LIPConfig
 
@@ -26,6 +27,7 @@ class DataConfig:
     the network sees objects at the same pixel scale and the samples at the same density as in training.
     Samplers: lipjax.data.sampling specs, or "input[:N]" for the data set's own sparse input.
     num_workers: loader worker processes (0: load in the training process).
+    augment: training augmentation applied with the crop (zoom, flip, photometric, blur, sample noise).
     """
 
     kind: str = "indoor"
@@ -41,6 +43,7 @@ class DataConfig:
     raw_root: str | None = None
     protocol: str | None = None
     depth_scale: float | None = None
+    augment: Augment = Augment()  # lipjax.data.augment; the default only crops
 
 
 @dataclasses.dataclass(frozen=True)

@@ -3,13 +3,13 @@
     train(config, workdir)   # resumes from workdir/checkpoints if present
 
 Layout of `workdir`: checkpoints/<step>/ (orbax), metrics.jsonl (one JSON object per logged step or evaluation),
-config.txt (the config's repr). Resume is exact: the state holds parameters, both optimiser states, the step
-and the RNG key; the data position is the step (batch s is a pure function of (seed, s), see
-lipjax.data.pipeline), recorded in each checkpoint's metadata and checked on resume.
+config.txt (the config's repr). A run writes nothing outside its workdir. Resume is exact: the state holds
+parameters, both optimiser states, the step and the RNG key; the data position is the step (batch s is a pure
+function of (seed, s), see lipjax.data.pipeline), recorded in each checkpoint's metadata with the loader's
+grain iterator state, and checked on resume.
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 import os
@@ -24,60 +24,24 @@ from tqdm.auto import tqdm
 
 from lipjax import model_io
 from lipjax.checkpoint import CheckpointManager, to_host
-from lipjax.data.pipeline import BatchIterator, make_data_mesh, prefetch, shard_batch
+from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader, make_data_mesh, shard_batch
+from lipjax.data.pipeline import validation_batches as source_validation_batches
 from lipjax.data.sample import Batch
-from lipjax.data.sampling import example_rng
 from lipjax.data.sources import open_source
 from lipjax.inference import compiled_apply
 from lipjax.metrics import MetricAggregator, compute_metrics
-from lipjax.model import host_inputs_of
 from lipjax.train.config import TrainConfig
 from lipjax.train.state import TrainState, init_state  # noqa: F401  (re-exported)
 from lipjax.train.steps import make_steps
-
-EVAL_BATCH_SIZE = 4
 
 
 class TrainingDiverged(RuntimeError):
     """A non-finite loss: training stops and the last good checkpoint is kept."""
 
 
-def random_crop(batch: Batch, crop: tuple[int, int] | None, seed: int, step: int, first_example: int = 0) -> Batch:
-    """Crops every example of a batch at a position drawn from (seed, step, example): resumable and deterministic.
-
-    `first_example` is the index of this batch's first example in the global batch (a process's slice in
-    multi-process training), so that every example is cropped as it would be in a single-process run.
-    """
-    if crop is None:
-        return batch
-    ch, cw = crop
-    _, h, w = batch.gt.shape
-    if (ch, cw) == (h, w):
-        return batch
-    if ch > h or cw > w:
-        raise ValueError(f"crop {crop} is larger than the {h}x{w} images")
-    corners = [example_rng(seed, f"crop/{step}/{first_example + i}").integers(0, (h - ch + 1, w - cw + 1))
-               for i in range(len(batch.gt))]
-    tops, lefts = [c[0] for c in corners], [c[1] for c in corners]
-
-    def cut(a):
-        return np.stack([x[t : t + ch, l : l + cw] for x, t, l in zip(a, tops, lefts)])
-
-    return Batch(rgb=cut(batch.rgb), sparse=cut(batch.sparse), gt=cut(batch.gt), gt_valid=cut(batch.gt_valid))
-
-
-def with_host_inputs(model_config, batch: Batch) -> Batch:
-    """Adds the host-computed initial estimate z0 to a (cropped) batch for models that need one."""
-    extra = host_inputs_of(model_config, batch.sparse)
-    return dataclasses.replace(batch, **extra) if extra else batch
-
-
 def validation_batches(config: TrainConfig) -> list[Batch]:
-    """The fixed validation set: the first `val_images` val frames of the source at full size, with val_sampler."""
-    source = open_source(config.data, "val")
-    it = BatchIterator(source.dataset, min(EVAL_BATCH_SIZE, len(source.dataset)), source.sampler, shuffle=False,
-                       drop_last=False, num_epochs=1)
-    return [with_host_inputs(config.model, b) for b in it]
+    """The fixed validation set of a run: the first `val_images` val frames of its source, with val_sampler."""
+    return source_validation_batches(open_source(config.data, "val"), config.model)
 
 
 def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: float) -> dict[str, float]:
@@ -131,6 +95,7 @@ def train(
 
     manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
     state = init_state(config, _initial_g_params(config))
+    meta: dict = {}
     if manager.latest_step() is not None:
         state, meta = manager.restore(state)
         if meta.get("data_position") != int(state.step):
@@ -147,18 +112,22 @@ def train(
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
     d = config.data
     source = open_source(d, "train")
-    batches = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
-                            start_step=start, process_index=process_index, process_count=process_count,
-                            num_workers=d.num_workers)
+    local = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
+                          process_index=process_index, process_count=process_count)
+    step_batches = StepBatches(local, config.total_steps, d.augment, d.crop, config.seed, config.model)
+    saved = meta.get("data_loader")
+    if saved is not None and saved["num_workers"] == d.num_workers and saved["next_step"] == start:
+        loader = TrainLoader(step_batches, saved["first_step"], d.num_workers, state=saved)
+    else:  # no saved loader state (an older checkpoint) or another worker count: same batches from the step
+        loader = TrainLoader(step_batches, start, d.num_workers)
     log = open(workdir / "metrics.jsonl", "a") if is_main else None
     bar = tqdm(total=end, initial=start, desc=config.name, disable=not (progress and is_main), dynamic_ncols=True)
     t_last, images = time.perf_counter(), 0
     step = start
     try:
-        with prefetch(iter(batches), 2) as stream:
+        with loader:
             for step in range(start, end):
-                batch = random_crop(next(stream), d.crop, config.seed, step, batches.local_batch_size * process_index)
-                batch = with_host_inputs(config.model, batch)
+                batch = next(loader)
                 phase = config.phase(step)
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
                 images += config.batch_size
@@ -184,7 +153,8 @@ def train(
                         log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
                         log.flush()
                 if done % config.checkpoint_every == 0 or done == end:
-                    manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name})
+                    manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
+                                               "data_loader": loader.state()})
                 if val and (done % config.eval_every == 0 or done == end):
                     # every process evaluates (the parameters live on all of them); the main one logs
                     vm = evaluate_params(config.model, state.g_params, val, max_depth)
@@ -195,7 +165,6 @@ def train(
                 bar.update(1)
     finally:
         bar.close()
-        batches.close()
         if log:
             log.close()
         manager.close()
