@@ -1,16 +1,16 @@
-"""Batch pipeline: determinism, per-epoch reshuffle, exact resume, prefetch, process slices, device sharding."""
+"""Batch pipeline: determinism, per-epoch reshuffle, exact resume, worker processes, process slices, sharding."""
 from __future__ import annotations
 
 import itertools
 import os
 import subprocess
 import sys
-import threading
 
 import numpy as np
 import pytest
 
-from lipjax.data.pipeline import BatchIterator, Prefetch, prefetch
+from lipjax.data.augment import Augment
+from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader
 from lipjax.data.protocols import Protocol, Resize
 from lipjax.data.sample import Batch, Intrinsics, Sample
 from lipjax.data.sampling import UniformSampler
@@ -103,17 +103,31 @@ def test_process_slices_are_disjoint_and_cover_the_global_batch():
         make(batch_size=3, process_count=2)
 
 
-def test_threads_equal_serial():
-    serial = list(itertools.islice(make(seed=9), 4))
-    with make(seed=9, num_workers=2) as threaded:
-        assert all(batches_equal(x, y) for x, y in zip(serial, itertools.islice(threaded, 4)))
+def step_batches(process_index=0, process_count=1, dataset=None) -> StepBatches:
+    it = make(dataset, batch_size=4, seed=9, process_index=process_index, process_count=process_count)
+    return StepBatches(it, 12, Augment(), (4, 6), 9, None)
 
 
-def test_prefetch_equals_no_prefetch():
-    plain = list(make(seed=4, num_epochs=2))
-    with prefetch(make(seed=4, num_epochs=2), buffer_size=2) as fetched:
-        got = list(fetched)
-    assert len(got) == len(plain) == 6 and all(batches_equal(x, y) for x, y in zip(plain, got))
+def test_step_batches_crop_and_slice_like_the_global_batch():
+    whole = step_batches()[5]
+    halves = [step_batches(p, 2)[5] for p in range(2)]
+    assert whole["gt"].shape == (4, 4, 6) and int(whole["step"]) == 5
+    for key in ("rgb", "sparse", "gt", "gt_valid"):  # each process crops its examples as one process would
+        assert np.array_equal(np.concatenate([h[key] for h in halves]), whole[key])
+
+
+def test_worker_processes_equal_in_process_loading_and_resume_from_state():
+    with TrainLoader(step_batches(), 0, num_workers=0) as loader:
+        serial = [next(loader) for _ in range(8)]
+    with TrainLoader(step_batches(), 0, num_workers=2) as loader:
+        parallel = [next(loader) for _ in range(5)]
+        state = loader.state()
+    assert all(batches_equal(x, y) for x, y in zip(serial, parallel))
+    assert state["next_step"] == 5 and state["num_workers"] == 2
+    with TrainLoader(step_batches(), state["first_step"], num_workers=2, state=state) as resumed:
+        assert all(batches_equal(x, next(resumed)) for x in serial[5:])
+    with TrainLoader(step_batches(), 5, num_workers=0) as restarted:  # another worker count: start at the step
+        assert batches_equal(serial[5], next(restarted))
 
 
 class Exploding:
@@ -131,22 +145,14 @@ class Exploding:
         return self.items[i]
 
 
-def test_prefetch_reraises_worker_exceptions_in_order():
+def test_loader_reraises_a_data_error_in_order():
+    it = make(Exploding(), shuffle=False, batch_size=2)
     consumed = []
     with pytest.raises(RuntimeError, match="corrupt example 4"):
-        for batch in Prefetch(make(Exploding(), shuffle=False, batch_size=2), buffer_size=3):
-            consumed.append(example_ids(batch))
+        with TrainLoader(StepBatches(it, 5, Augment(), None, 0, None), 0, num_workers=0) as loader:
+            for _ in range(5):
+                consumed.append(example_ids(next(loader)))
     assert consumed == [[0, 1], [2, 3]]
-
-
-def test_prefetch_closes_cleanly_when_abandoned():
-    before = threading.active_count()
-    fetched = Prefetch(itertools.count(), buffer_size=2)  # endless producer, blocked on the full queue
-    assert [next(fetched) for _ in range(3)] == [0, 1, 2]
-    fetched.close()
-    assert not fetched._thread.is_alive() and threading.active_count() == before
-    with pytest.raises(StopIteration):
-        next(fetched)
 
 
 def test_shard_batch_single_device():

@@ -1,11 +1,16 @@
-"""Batches for training and evaluation: deterministic, resumable, prefetched, and placed across devices.
+"""Batches for training and evaluation: deterministic, resumable, loaded in worker processes, placed on devices.
 
-    dataset[i] -> protocol -> sampler (keyed by the example id) -> Batch -> shard_batch -> jax.Arrays
+    dataset[i] -> protocol -> sampler (keyed by the example id) -> Batch -> augment + crop -> z0 -> shard_batch
 
 Order. Step s of a run maps to (epoch, offset) = divmod(s, steps_per_epoch); epoch e visits the examples in
 a permutation drawn from (seed, e) (or in order when shuffle=False). So batch s is a pure function of
-(dataset, seed, s): a run resumed with start_step=s yields exactly what the original run would have yielded
-from step s on, and every epoch has a different order.
+(dataset, seed, s): a run resumed at step s yields exactly what the original run would have yielded from
+step s on, and every epoch has a different order.
+
+Workers. `TrainLoader` runs the whole per-step work (reading, sampling, augmentation and crop, the host z0
+fill) in `num_workers` grain worker processes (grain.IterDataset.mp_prefetch): element s of its grain
+MapDataset is this process's batch of step s, so the worker count changes the speed, never the batches.
+Its state (grain's iterator state) is saved in each checkpoint's metadata and restored on resume.
 
 Multi-host. Every process builds the same BatchIterator (same seed, same global batch_size) with its own
 process_index / process_count = jax.process_index() / jax.process_count(); it loads only its contiguous
@@ -15,19 +20,19 @@ the same code.
 """
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import math
-import queue
-import threading
-from typing import Any, Iterable, Iterator, Sequence
+from typing import Any, Iterator, Sequence
 
 import numpy as np
 
+from lipjax.data.augment import Augment, augment_batch
 from lipjax.data.sample import Batch, Sample
 from lipjax.data.sampling import SparseSampler
 
 DATA_AXIS = "data"
+EVAL_BATCH_SIZE = 4
+WORKER_BUFFER = 2  # batches each worker process prepares ahead
 
 
 class BatchIterator:
@@ -45,13 +50,12 @@ class BatchIterator:
       num_epochs: stop after this many epochs (counted from epoch 0); None = endless.
       process_index, process_count: this process's slice of each global batch.
       sample_seed: seed passed to the sampler; the sparse points of an example depend only on it and the id.
-      num_workers: threads loading the examples of a batch in parallel (0: load in the calling thread).
     """
 
     def __init__(self, dataset: Any, batch_size: int, sampler: SparseSampler, protocol: Any = None, *,
                  seed: int = 0, shuffle: bool = True, drop_last: bool = True, start_step: int = 0,
                  num_epochs: int | None = None, process_index: int = 0, process_count: int = 1,
-                 sample_seed: int = 0, num_workers: int = 0):
+                 sample_seed: int = 0):
         if batch_size < 1:
             raise ValueError(f"batch_size must be >= 1, got {batch_size}")
         if not 0 <= process_index < process_count:
@@ -66,12 +70,11 @@ class BatchIterator:
         self.seed, self.shuffle, self.drop_last = seed, shuffle, drop_last
         self.start_step, self.num_epochs = start_step, num_epochs
         self.process_index, self.process_count = process_index, process_count
-        self.sample_seed, self.num_workers = sample_seed, num_workers
+        self.sample_seed = sample_seed
         self.num_examples = len(dataset)
         self.steps_per_epoch = self.num_examples // batch_size if drop_last else math.ceil(self.num_examples / batch_size)
         if self.steps_per_epoch == 0:
             raise ValueError(f"dataset of {self.num_examples} examples gives no batch of {batch_size} (drop_last={drop_last})")
-        self._pool: concurrent.futures.ThreadPoolExecutor | None = None
 
     @property
     def local_batch_size(self) -> int:
@@ -110,13 +113,7 @@ class BatchIterator:
 
     def batch(self, step: int) -> Batch:
         """This process's Batch of global step `step` (a pure function of the step)."""
-        indices = self.local_indices(step)
-        if self.num_workers > 0:
-            if self._pool is None:
-                self._pool = concurrent.futures.ThreadPoolExecutor(self.num_workers, thread_name_prefix="lipjax-data")
-            examples = list(self._pool.map(self.example, indices))  # map keeps the order
-        else:
-            examples = [self.example(i) for i in indices]
+        examples = [self.example(i) for i in self.local_indices(step)]
         shapes = {s.shape for s, _ in examples}
         if len(shapes) > 1:
             raise ValueError(f"examples of step {step} have different sizes {sorted(shapes)}; use a protocol")
@@ -143,111 +140,111 @@ class BatchIterator:
             yield self.batch(step)
             step += 1
 
-    def close(self) -> None:
-        """Stops the loading threads (if any)."""
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=True)
-            self._pool = None
 
-    def __enter__(self) -> "BatchIterator":
-        return self
+def with_host_inputs(model_config: Any, batch: Batch) -> Batch:
+    """Adds the host-computed initial estimate z0 (metres) to a (cropped) batch for models that need one."""
+    from lipjax.model import host_inputs_of  # imported here so data-only users do not import JAX
 
-    def __exit__(self, *exc) -> None:
-        self.close()
+    extra = host_inputs_of(model_config, batch.sparse)
+    return dataclasses.replace(batch, **extra) if extra else batch
 
 
-@dataclasses.dataclass
-class _Raised:
-    error: BaseException
+def validation_batches(source: Any, model_config: Any, batch_size: int = EVAL_BATCH_SIZE) -> list[Batch]:
+    """Every frame of a Source (lipjax.data.sources) at full size, in order, with its z0: a fixed validation set."""
+    it = BatchIterator(source.dataset, min(batch_size, len(source.dataset)), source.sampler, shuffle=False,
+                       drop_last=False, num_epochs=1)
+    return [with_host_inputs(model_config, b) for b in it]
 
 
-_DONE = object()
+@dataclasses.dataclass(frozen=True)
+class StepBatches:
+    """A grain data source whose element s is this process's finished training batch of global step s.
 
-
-def _put(q: queue.Queue, stop: threading.Event, item: Any) -> bool:
-    """Puts unless stopped; polls so that a stop request is noticed while the queue is full."""
-    while not stop.is_set():
-        try:
-            q.put(item, timeout=0.1)
-            return True
-        except queue.Full:
-            continue
-    return False
-
-
-def _produce(iterator: Iterator[Any], q: queue.Queue, stop: threading.Event) -> None:
-    try:
-        for item in iterator:
-            if not _put(q, stop, item):
-                return
-    except BaseException as error:  # noqa: BLE001 - handed to the consumer, which re-raises it
-        _put(q, stop, _Raised(error))
-        return
-    _put(q, stop, _DONE)
-
-
-class Prefetch:
-    """Iterates `iterable` in a background thread, up to `buffer_size` items ahead.
-
-    Items come out in the same order as from the iterable; an exception raised by the iterable is re-raised
-    in the consumer (at the point where the failing item would have arrived). close() (or leaving a `with`
-    block, or exhausting the iterator) stops the thread; a producer blocked on a full queue notices within
-    0.1 s.
+    Element s = with_host_inputs(augment_batch(iterator.batch(s))), as a dict of arrays plus "step": the
+    reading, sampling, augmentation, crop and z0 fill of a step all run wherever the element is made (a
+    worker process). Picklable when the data set and sampler are.
     """
 
-    def __init__(self, iterable: Iterable[Any], buffer_size: int = 2):
-        if buffer_size < 1:
-            raise ValueError(f"buffer_size must be >= 1, got {buffer_size}")
-        self._queue: queue.Queue = queue.Queue(maxsize=buffer_size)
-        self._stop = threading.Event()
-        self._finished = False
-        # The thread must not reference self, so an abandoned Prefetch is collected and __del__ stops it.
-        self._thread = threading.Thread(target=_produce, args=(iter(iterable), self._queue, self._stop),
-                                        name="lipjax-prefetch", daemon=True)
-        self._thread.start()
+    iterator: BatchIterator
+    num_steps: int
+    augment: Augment
+    crop: tuple[int, int] | None
+    seed: int
+    model_config: Any
 
-    def __iter__(self) -> "Prefetch":
+    def __len__(self) -> int:
+        return self.num_steps
+
+    def __getitem__(self, step: int) -> dict[str, np.ndarray]:
+        step = int(step)
+        first = self.iterator.local_batch_size * self.iterator.process_index
+        batch = augment_batch(self.iterator.batch(step), self.augment, self.crop, self.seed, step, first)
+        return {"step": np.int64(step), **with_host_inputs(self.model_config, batch).as_dict()}
+
+
+def _grain():
+    """grain, with absl flags marked parsed when the program has not parsed them (grain reads its flags)."""
+    import grain
+    from absl import flags
+
+    if not flags.FLAGS.is_parsed():
+        flags.FLAGS.mark_as_parsed()
+    return grain
+
+
+class TrainLoader:
+    """Training batches of steps [first_step, len(steps)) from `num_workers` grain worker processes, in order.
+
+    Args:
+      steps: a StepBatches.
+      first_step: the step the grain data set starts at (a run's start, or the restored state's).
+      num_workers: worker processes (0: one background thread in this process).
+      state: a `state()` saved by an earlier loader with the same first_step and num_workers (resume).
+    Iterating yields Batch; each element's step is checked against the expected one, so a state restored into
+    a different setup fails loudly instead of training on the wrong batches.
+    """
+
+    def __init__(self, steps: StepBatches, first_step: int = 0, num_workers: int = 0, state: dict | None = None):
+        grain = _grain()
+        self.first_step, self.num_workers = first_step, num_workers
+        dataset = grain.MapDataset.source(steps)[first_step:].to_iter_dataset(
+            grain.ReadOptions(num_threads=1, prefetch_buffer_size=WORKER_BUFFER))
+        if num_workers > 0:
+            dataset = dataset.mp_prefetch(grain.MultiprocessingOptions(num_workers=num_workers,
+                                                                       per_worker_buffer_size=WORKER_BUFFER))
+        self._iterator = iter(dataset)
+        if state is not None:
+            self._iterator.set_state(state["grain"])
+        self.next_step = first_step if state is None else int(state["next_step"])
+
+    def state(self) -> dict:
+        """JSON-serialisable position (grain iterator state, next step, first step, worker count)."""
+        return {"grain": self._iterator.get_state(), "next_step": self.next_step, "first_step": self.first_step,
+                "num_workers": self.num_workers}
+
+    def __iter__(self) -> "TrainLoader":
         return self
 
-    def __next__(self) -> Any:
-        if self._finished:
-            raise StopIteration
-        item = self._queue.get()
-        if item is _DONE:
-            self.close()
-            raise StopIteration
-        if isinstance(item, _Raised):
-            self.close()
-            raise item.error
-        return item
+    def __next__(self) -> Batch:
+        arrays = dict(next(self._iterator))
+        step = int(arrays.pop("step"))
+        if step != self.next_step:
+            raise RuntimeError(f"the data loader yielded step {step}, expected {self.next_step}; "
+                               "remove the checkpoint's data_loader state or start a new workdir")
+        self.next_step += 1
+        return Batch(**arrays)
 
     def close(self) -> None:
-        """Stops the producer and waits for it."""
-        self._finished = True
-        self._stop.set()
-        while True:  # unblock a producer waiting on a full queue
-            try:
-                self._queue.get_nowait()
-            except queue.Empty:
-                break
-        if self._thread is not threading.current_thread():
-            self._thread.join(timeout=10.0)
+        """Stops the worker processes."""
+        close = getattr(self._iterator, "close", None)
+        if close is not None:
+            close()
 
-    def __enter__(self) -> "Prefetch":
+    def __enter__(self) -> "TrainLoader":
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
-
-    def __del__(self) -> None:
-        if not getattr(self, "_finished", True):
-            self._finished = True
-            self._stop.set()
-
-
-def prefetch(iterable: Iterable[Any], buffer_size: int = 2) -> Prefetch:
-    """Background-thread prefetch of `buffer_size` items (see Prefetch)."""
-    return Prefetch(iterable, buffer_size)
 
 
 def make_data_mesh(devices: Sequence[Any] | None = None):
