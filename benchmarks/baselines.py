@@ -124,7 +124,7 @@ class Setting:
 @dataclasses.dataclass
 class Downsized:
     """A method run on the frame downsized to `max_side` (longer side), upsampled back with the measured pixels
-    re-imposed (lipjax.cli.complete_frame): e.g. real KITTI frames at the scale of the outdoor training renders."""
+    re-imposed (lipjax.inference.complete_frame): e.g. real KITTI frames at the scale of the outdoor training renders."""
 
     method: object
     max_side: int
@@ -134,7 +134,7 @@ class Downsized:
         return f"{self.method.name}@{self.max_side}"
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        from lipjax.cli import complete_frame
+        from lipjax.inference import complete_frame
 
         return complete_frame(self.method, rgb, sparse, self.max_side)
 

@@ -1,11 +1,13 @@
-"""The `lipjax` command: complete depth on your own images, evaluate, train, export, list models.
+"""The `lipjax` command: complete depth on your own images, evaluate, export, list models. It parses arguments
+and calls the library (lipjax.inference, lipjax.data.folder, lipjax.pointcloud, lipjax.evaluate, lipjax.export);
+each subcommand is one `_cmd_*` function registered in `build_parser`.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
-    lipjax train --config NAME [...]            (= python -m experiments.train)
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
     lipjax models
+    lipjax --version
 
 `complete`, inputs and outputs:
   --rgb     colour image (.png / .jpg), or a folder of them.
@@ -37,28 +39,23 @@ towards the measurements, paper eq. 6).
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
+A frame above 2 Mpixel run without --max-side gets a one-line hint.
 """
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import sys
 from pathlib import Path
 
-import numpy as np
+from lipjax import console
 
 PROG = "lipjax"
 DEFAULT_PNG_OUT_SCALE = 256.0
-OUT_FORMATS = ("npy", "png", "color.png")
-
-
-class CLIError(Exception):
-    """A problem the user can fix; printed as one line, no traceback."""
+CLIError = console.UserError
 
 
 def _warn(message: str) -> None:
-    print(f"{PROG}: warning: {message}", file=sys.stderr)
+    console.warn(PROG, message)
 
 
 # ------------------------------------------------------------------------------------------- argument types
@@ -88,30 +85,19 @@ def _positive_int(text: str) -> int:
     return value
 
 
-# -------------------------------------------------------------------------------------------------- models
+def _intrinsics_from_args(args):
+    """The checked Intrinsics of --intrinsics / --intrinsics-file, or None when neither was given."""
+    from lipjax.data.folder import read_intrinsics_txt
+    from lipjax.pointcloud import as_intrinsics
 
-
-def load_completer(model: str | None, iterations: int | None = None):
-    """The completer for --model: a lipjax.methods name (shipped model, saved model path, lip-wavelet,
-    nearest, ...) or None: the shipped default model, else an untrained model with a warning."""
-    import lipjax
-    from lipjax.inference import DEFAULT_MODEL
-    from lipjax.methods import get_method
-
-    if model is None:
-        if DEFAULT_MODEL in lipjax.available_models():
-            completer = lipjax.load_model(DEFAULT_MODEL)
-        else:
-            _warn(f"no trained weights shipped ({DEFAULT_MODEL!r} is not in `lipjax models`): using an UNTRAINED "
-                  "model, whose output is only a smooth fill of the samples; pass --model NAME|PATH")
-            completer = lipjax.Completer.random()
-    else:
-        completer = get_method(model)
-    if iterations is not None:
-        if not hasattr(completer, "with_iterations"):
-            raise CLIError(f"--iterations applies to LIP models; {model!r} is not one")
-        completer = completer.with_iterations(iterations)
-    return completer
+    if getattr(args, "intrinsics", None):
+        try:
+            return as_intrinsics(args.intrinsics)
+        except ValueError as exc:
+            raise CLIError(f"--intrinsics {' '.join(f'{v:g}' for v in args.intrinsics)}: {exc}") from exc
+    if getattr(args, "intrinsics_file", None):
+        return read_intrinsics_txt(args.intrinsics_file)
+    return None
 
 
 def _model_max_depth(completer) -> float:
@@ -120,123 +106,17 @@ def _model_max_depth(completer) -> float:
     return float(getattr(getattr(completer, "config", None), "max_depth_m", 10.0))
 
 
-# ------------------------------------------------------------------------------------------- frame helpers
-
-
-def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """Moves each measured pixel of a (H, W) sparse map to the pixel of a (h, w) grid its centre falls in.
-
-    Values are kept (never averaged or interpolated); where several samples land in one pixel the nearest
-    (smallest depth) wins, as a z-buffer. Returns (h, w) float32 metres, 0 = no sample.
-    """
-    sparse = np.asarray(sparse_m, np.float32)
-    big_h, big_w = sparse.shape
-    h, w = size
-    rows, cols = np.nonzero(sparse > 0)
-    z = sparse[rows, cols]
-    r = np.minimum(((rows + 0.5) * h / big_h).astype(np.int64), h - 1)
-    c = np.minimum(((cols + 0.5) * w / big_w).astype(np.int64), w - 1)
-    pixel = r * w + c
-    order = np.lexsort((z, pixel))
-    pixel, z = pixel[order], z[order]
-    first = np.ones(pixel.size, bool)
-    first[1:] = pixel[1:] != pixel[:-1]
-    out = np.zeros(h * w, np.float32)
-    out[pixel[first]] = z[first]
-    return out.reshape(h, w)
-
-
-def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
-    """Dense (H, W) float32 metres for one frame; with max_side, run downsized (see the module docstring)."""
-    import cv2
-
-    big_h, big_w = sparse_m.shape
-    if max_side is None or max(big_h, big_w) <= max_side:
-        return np.asarray(completer(rgb, sparse_m), np.float32)
-    s = max_side / max(big_h, big_w)
-    h, w = max(1, round(big_h * s)), max(1, round(big_w * s))
-    small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
-    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
-    measured = sparse_m > 0
-    dense[measured] = sparse_m[measured]
-    return dense.astype(np.float32)
-
-
-def _read_frame(rgb_path: Path, depth_path: Path, scale: float | None) -> tuple[np.ndarray, np.ndarray]:
-    from lipjax.data.folder import read_depth, read_rgb
-
-    rgb = read_rgb(rgb_path)
-    suffix = depth_path.suffix.lower()
-    if suffix == ".png" and scale is None:
-        raise CLIError(f"{depth_path}: a PNG depth map has no unit; pass --depth-scale S (metres = value / S): "
-                       "KITTI 256, NYU 1000, TUM 5000")
-    if suffix not in (".png", ".npy"):
-        raise CLIError(f"{depth_path}: unsupported depth format {suffix!r} (use a 16-bit .png with --depth-scale, or .npy in metres)")
-    sparse = read_depth(depth_path, scale if suffix == ".png" else None)
-    if sparse.shape != rgb.shape[:2]:
-        raise CLIError(f"{depth_path}: sparse depth is {sparse.shape[0]}x{sparse.shape[1]} but the RGB image {rgb_path} "
-                       f"is {rgb.shape[0]}x{rgb.shape[1]}; the depth must be aligned with the RGB image pixel for "
-                       "pixel (project your LiDAR into the camera: lipjax.pointcloud.project_lidar_to_depth)")
-    if not (sparse > 0).any():
-        raise CLIError(f"{depth_path}: the sparse depth map is empty (no pixel > 0); nothing to complete from")
-    return rgb, sparse
-
-
-def _output_format(path: Path) -> str:
-    name = path.name.lower()
-    for fmt in ("color.png", "npy", "png"):
-        if name.endswith("." + fmt):
-            return fmt
-    raise CLIError(f"--out {path}: unknown extension; use .npy (metres), .png (16-bit, scale S) or .color.png (picture)")
-
-
-def _write_depth(path: Path, dense: np.ndarray, fmt: str, out_scale: float, color_range: tuple[float, float]) -> None:
-    import cv2
-
-    from lipjax import viz
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if fmt == "npy":
-        np.save(path, dense.astype(np.float32))
-    elif fmt == "color.png":
-        viz.write_png(path, viz.colorize_depth(dense, *color_range))
-    else:
-        raw = np.round(dense.astype(np.float64) * out_scale)
-        if raw.max() > 65535:
-            _warn(f"{path}: depth above {65535 / out_scale:.1f} m does not fit a 16-bit PNG at scale {out_scale:g}; "
-                  "clipped (use a smaller --depth-scale or .npy)")
-        if not cv2.imwrite(os.fspath(path), np.clip(raw, 0, 65535).astype(np.uint16)):
-            raise OSError(f"cannot write {path}")
-
-
-def _intrinsics_from_args(args):
-    from lipjax.data.folder import read_intrinsics_txt
-    from lipjax.data.sample import Intrinsics
-
-    if getattr(args, "intrinsics", None):
-        return Intrinsics(*args.intrinsics)
-    if getattr(args, "intrinsics_file", None):
-        return read_intrinsics_txt(args.intrinsics_file)
-    return None
-
-
-def _pair_folders(rgb_dir: Path, depth_dir: Path) -> list[tuple[Path, Path]]:
-    """(rgb, depth) paths paired as FolderDataset pairs them (lipjax.data.folder.pair_frames)."""
-    from lipjax.data.folder import pair_frames
-
-    return [(rgb, depth) for _, rgb, depth in pair_frames(rgb_dir, depth_dir)]
-
-
 # ------------------------------------------------------------------------------------------------ commands
 
 
 def _cmd_complete(args) -> int:
+    from lipjax.data.folder import check_one_depth_format, output_format, pair_frames, read_frame, write_depth
+    from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, get_completer
     from lipjax.pointcloud import backproject_rgbd, write_ply
 
-    rgb_path, depth_path, out = Path(args.rgb), Path(args.depth), Path(args.out)
+    rgb_path, depth_path, out, ply = Path(args.rgb), Path(args.depth), Path(args.out), args.ply and Path(args.ply)
     intrinsics = _intrinsics_from_args(args)
-    if args.ply and intrinsics is None:
+    if ply and intrinsics is None:
         raise CLIError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
     if args.color_range and not args.color_range[1] > args.color_range[0]:
         raise CLIError(f"--color-range {args.color_range[0]:g} {args.color_range[1]:g}: MAX_M must be > MIN_M")
@@ -246,33 +126,37 @@ def _cmd_complete(args) -> int:
     if rgb_path.is_dir() != depth_path.is_dir():
         raise CLIError("--rgb and --depth must both be files or both be folders")
     if rgb_path.is_dir():
-        pairs = _pair_folders(rgb_path, depth_path)
-        if out.exists() and not out.is_dir():
-            raise CLIError(f"--out {out}: with input folders, OUT must be a folder")
-        if args.ply and Path(args.ply).exists() and not Path(args.ply).is_dir():
-            raise CLIError(f"--ply {args.ply}: with input folders, --ply must be a folder")
-        fmt = args.out_format or ("png" if all(d.suffix.lower() == ".png" for _, d in pairs) else "npy")
-        jobs = [(r, d, out / f"{r.stem}.{fmt}", Path(args.ply) / f"{r.stem}.ply" if args.ply else None) for r, d in pairs]
+        pairs = [(r, d) for _, r, d in pair_frames(rgb_path, depth_path)]
+        check_one_depth_format([d for _, d in pairs])
+        for flag, path in (("--out", out), ("--ply", ply)):
+            if path and path.exists() and not path.is_dir():
+                raise CLIError(f"{flag} {path}: with input folders, {flag} must be a folder")
+        fmt = args.out_format or ("png" if pairs[0][1].suffix.lower() == ".png" else "npy")
+        jobs = [(r, d, out / f"{r.stem}.{fmt}", ply / f"{r.stem}.ply" if ply else None) for r, d in pairs]
     else:
         if args.out_format:
             raise CLIError("--out-format is for folders; for one frame the extension of --out chooses the format")
-        fmt = _output_format(out)
-        jobs = [(rgb_path, depth_path, out, Path(args.ply) if args.ply else None)]
+        fmt = output_format(out)
+        jobs = [(rgb_path, depth_path, out, ply or None)]
     out_scale = args.depth_scale or DEFAULT_PNG_OUT_SCALE
 
     completer = None  # loaded after the first frame is read: input errors come before the slow model load
-    frames = (_read_frame(r, d, args.depth_scale) for r, d, _, _ in jobs)
     progress = jobs
     if len(jobs) > 1 and not args.quiet:
         from tqdm import tqdm
 
         progress = tqdm(jobs, desc=f"{PROG} complete", unit="frame", file=sys.stderr)
-    for (_, _, out_file, ply_file), (rgb, sparse) in zip(progress, frames):
+    for rgb_file, depth_file, out_file, ply_file in progress:
+        rgb, sparse = read_frame(rgb_file, depth_file, args.depth_scale)
         if completer is None:
-            completer = load_completer(args.model, args.iterations)
+            completer = get_completer(args.model, args.iterations)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
+            if args.max_side is None and sparse.size > LARGE_FRAME_PIXELS:
+                _warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) runs "
+                      "slowly and needs gigabytes at full size; --max-side 1024 runs it downsized (--max-side 416 "
+                      "with the shipped outdoor models, their training scale)")
         dense = complete_frame(completer, rgb, sparse, args.max_side)
-        _write_depth(out_file, dense, fmt, out_scale, color_range)
+        write_depth(out_file, dense, fmt, out_scale, color_range)
         if ply_file is not None:
             ply_file.parent.mkdir(parents=True, exist_ok=True)
             write_ply(ply_file, *backproject_rgbd(dense, rgb, intrinsics))
@@ -283,11 +167,20 @@ def _cmd_complete(args) -> int:
     return 0
 
 
+def _needs_intrinsics(sampler) -> bool:
+    """Whether a sampler (lipjax.data.sampling) uses the camera intrinsics: the LiDAR simulation does."""
+    from lipjax.data.sampling import LidarSampler
+
+    inner = getattr(sampler, "samplers", None) or (getattr(sampler, "sampler", sampler),)
+    return any(isinstance(s, LidarSampler) or (s is not sampler and _needs_intrinsics(s)) for s in inner)
+
+
 def _cmd_evaluate(args) -> int:
     from lipjax.data import protocols
     from lipjax.data.sample import Intrinsics
     from lipjax.data.sampling import sampler_from_spec
     from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json
+    from lipjax.inference import get_completer
 
     sampler = sampler_from_spec(args.sampler)
     protocol = protocols.get_protocol(args.protocol) if args.protocol else None
@@ -307,7 +200,11 @@ def _cmd_evaluate(args) -> int:
             raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
         intrinsics = _intrinsics_from_args(args)
         if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
-            intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # metrics do not use intrinsics
+            if _needs_intrinsics(sampler):
+                raise CLIError(f"--sampler {args.sampler} simulates a LiDAR and needs the camera intrinsics of the "
+                               f"frames in {root}: pass --intrinsics fx fy cx cy or --intrinsics-file F, or write "
+                               f"{root / 'intrinsics.txt'} (fx fy cx cy)")
+            intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # unused: neither this sampler nor the metrics need them
         dataset = FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics)
         range_from = protocol
     if protocol is not None:
@@ -319,7 +216,7 @@ def _cmd_evaluate(args) -> int:
     columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
     results = {}
     for model in args.model or [None]:
-        completer = load_completer(model, args.iterations)
+        completer = get_completer(model, args.iterations)
         label = model if model is not None else ("untrained" if completer.name == "random" else completer.name)
         results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
                                   limit=args.limit, progress=not args.quiet, seed=args.seed)
@@ -334,8 +231,9 @@ def _cmd_evaluate(args) -> int:
 
 def _cmd_export(args) -> int:
     from lipjax.export import export_completer, save_exported
+    from lipjax.inference import get_completer
 
-    completer = load_completer(args.model, args.iterations)
+    completer = get_completer(args.model, args.iterations)
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     exported = export_completer(completer, args.batch, args.height, args.width, platforms=platforms)
     try:
@@ -358,29 +256,15 @@ def _cmd_models(args) -> int:
     names = model_io.available()
     if not names:
         print(f"no shipped models in {model_io.WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. "
-              "Train one with `lipjax train --config lip_cnn_indoor`, or pass --model PATH to a saved model.")
+              "Train one with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
         return 0
     for name in names:
-        doc = json.loads((model_io.WEIGHTS_DIR / f"{name}.json").read_text())
-        config, meta = doc.get("config", {}), doc.get("metadata", {})
+        meta = model_io.metadata(name)
         rmse = meta.get("val_metrics", {}).get("rmse_m")
-        parts = [name + (" (default)" if name == DEFAULT_MODEL else ""),
-                 f"K={config.get('num_iterations')}", f"max_depth={config.get('prior', {}).get('max_depth_m')} m"]
+        parts = [name + (" (default)" if name == DEFAULT_MODEL else ""), model_io.summary(name)]
         if rmse is not None:
             parts.append(f"val rmse_m={rmse:.4f} ({meta.get('val_sampler', '?')}, {meta.get('data', '?')})")
         print("  ".join(parts))
-    return 0
-
-
-def _cmd_train(argv: list[str]) -> int:
-    try:
-        from experiments import train as train_module
-    except ImportError as exc:
-        raise CLIError(f"`lipjax train` needs the experiments package of the lipjax source checkout ({exc})") from exc
-    try:
-        train_module.main(argv)
-    except SystemExit as exit_:  # its argparse: --help or a usage error (already printed)
-        return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 2)
     return 0
 
 
@@ -397,9 +281,12 @@ def _cmd_data_render(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from lipjax import __version__
     from lipjax.data import protocols
+    from lipjax.data.folder import OUT_FORMATS
 
-    parser = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = console.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
@@ -447,8 +334,6 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--quiet", action="store_true")
     e.set_defaults(func=_cmd_evaluate)
 
-    sub.add_parser("train", add_help=False, help="train a model: lipjax train --config NAME (see lipjax train --help)")
-
     x = sub.add_parser("export", help="export a model as StableHLO (jax.export) for a fixed input shape")
     x.add_argument("--model", default=None)
     x.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
@@ -479,37 +364,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line(exc: BaseException) -> str:
-    lines = [line.strip() for line in (str(exc) or type(exc).__name__).splitlines() if line.strip()]
-    return " | ".join(lines)
+def _run(argv: list[str]) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        from lipjax.utils import enable_compilation_cache
+
+        enable_compilation_cache()
+    except OSError as exc:
+        _warn(f"no persistent compilation cache ({exc}); every run compiles from scratch")
+    return args.func(args)
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Runs the command line; returns the exit status (0 ok, 1 user error, 2 usage error)."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    try:
-        if argv and argv[0] == "train":
-            args = None
-        else:
-            try:
-                args = build_parser().parse_args(argv)
-            except SystemExit as exit_:  # --help, or a usage error argparse has printed
-                return exit_.code if isinstance(exit_.code, int) else (0 if exit_.code is None else 2)
-        try:
-            from lipjax.utils import enable_compilation_cache
-
-            enable_compilation_cache()
-        except OSError as exc:
-            _warn(f"no persistent compilation cache ({exc}); every run compiles from scratch")
-        return _cmd_train(argv[1:]) if args is None else args.func(args)
-    except (CLIError, ValueError, FileNotFoundError, OSError) as exc:  # InputError, DatasetError are ValueErrors
-        if os.environ.get("LIPJAX_DEBUG"):
-            raise
-        print(f"{PROG}: error: {_one_line(exc)}", file=sys.stderr)
-        return 1
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return 130
+    """Runs the command line; returns the exit status (0 ok, 1 user error, 2 usage error; lipjax.console)."""
+    return console.run_main(PROG, _run, list(sys.argv[1:] if argv is None else argv))
 
 
 if __name__ == "__main__":

@@ -1,5 +1,8 @@
 """The jit-compiled inference entry point: `Completer` (a model with its parameters); inputs checked by lipjax.inputs.
 
+Also the frame-level helpers the command line calls: `get_completer` (a model by name, path or object, or the
+default model), and `complete_frame`, which can run a large frame at a reduced size (`max_side`).
+
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
 same size, and returns dense depth in metres. The solver is compiled once per (config, input shape): jit caches
 one executable per shape, and `compiled_apply` caches the jitted function per config (the training loop's
@@ -19,6 +22,7 @@ import numpy as np
 from lipjax import model_io
 from lipjax.inputs import InputError, check_inputs  # noqa: F401  (re-exported: lipjax.InputError)
 from lipjax.model import LIPConfig, host_inputs_of
+from lipjax.zbuffer import splat_nearest
 
 DEFAULT_MODEL = "lip-ad-indoor"
 
@@ -32,7 +36,6 @@ def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
         return config.apply(params, rgb, sparse, return_trajectory=return_trajectory, **extra)
 
     return jax.jit(run)
-
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -90,21 +93,79 @@ def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:
 
 
 @functools.lru_cache(maxsize=1)
-def _default_model() -> Completer:
+def default_model() -> Completer:
+    """The shipped DEFAULT_MODEL (loaded once), or, while no weights are shipped, an untrained model (warns)."""
     if DEFAULT_MODEL in model_io.available():
         return load_model(DEFAULT_MODEL)
-    warnings.warn(f"no trained weights shipped ({DEFAULT_MODEL!r}); using an untrained model", stacklevel=3)
+    warnings.warn(f"no trained weights shipped ({DEFAULT_MODEL!r} is not in `lipjax models`): using an UNTRAINED "
+                  "model, whose output is only a smooth fill of the samples; pass a model name or path", stacklevel=2)
     return Completer.random()
 
 
-def complete(rgb: np.ndarray, sparse: np.ndarray, model: Completer | str | None = None) -> np.ndarray:
+def get_completer(model: Any = None, iterations: int | None = None):
+    """A completer: `model` is a completer object, any `lipjax.methods` name (shipped model, saved model path,
+    lip-wavelet, nearest, linear, ip_basic, colorization) or None (`default_model()`). With `iterations`, a LIP
+    model runs only its first K iterations."""
+    if model is None:
+        completer = default_model()
+    elif isinstance(model, (str, os.PathLike)):
+        from lipjax.methods import get_method  # lipjax.methods imports this module
+
+        completer = get_method(os.fspath(model))
+    else:
+        completer = model
+    if iterations is not None:
+        if not hasattr(completer, "with_iterations"):
+            raise ValueError(f"iterations apply to LIP models; {getattr(completer, 'name', model)!r} is not one")
+        completer = completer.with_iterations(iterations)
+    return completer
+
+
+def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None) -> np.ndarray:
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
-    `model` is a Completer, a shipped model name or a path; by default the shipped DEFAULT_MODEL (loaded once),
-    or, while no weights are shipped, an untrained model (with a warning).
+    `model`: a completer, a shipped model name, a saved model path or any `lipjax.methods` name ("linear",
+    "ip_basic", ...); by default the shipped DEFAULT_MODEL (see `default_model`).
     """
-    if isinstance(model, Completer):
-        return model(rgb, sparse)
-    if model is not None:
-        return load_model(model)(rgb, sparse)
-    return _default_model()(rgb, sparse)
+    return get_completer(model)(rgb, sparse)
+
+
+# A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
+LARGE_FRAME_PIXELS = 2_000_000
+
+
+def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """Moves each measured pixel of a (H, W) sparse map to the pixel of a (h, w) grid its centre falls in.
+
+    Values are kept (never averaged or interpolated); where several samples land in one pixel the nearest
+    (smallest depth) wins, as a z-buffer. Returns (h, w) float32 metres, 0 = no sample.
+    """
+    sparse = np.asarray(sparse_m, np.float32)
+    big_h, big_w = sparse.shape
+    h, w = size
+    rows, cols = np.nonzero(sparse > 0)
+    r = np.minimum(((rows + 0.5) * h / big_h).astype(np.int64), h - 1)
+    c = np.minimum(((cols + 0.5) * w / big_w).astype(np.int64), w - 1)
+    return splat_nearest(r * w + c, sparse[rows, cols], (h, w))
+
+
+def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
+    """Dense (H, W) float32 metres for one frame.
+
+    With `max_side` and a longer side above it, the model runs at a reduced size whose longer side is max_side:
+    the RGB is area-resized, the samples are moved onto the small grid (`reproject_sparse`), the result is
+    resized back (bilinear), and the measured pixels are set back to their measured values exactly.
+    """
+    import cv2
+
+    big_h, big_w = sparse_m.shape
+    if max_side is None or max(big_h, big_w) <= max_side:
+        return np.asarray(completer(rgb, sparse_m), np.float32)
+    s = max_side / max(big_h, big_w)
+    h, w = max(1, round(big_h * s)), max(1, round(big_w * s))
+    small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
+    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
+    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    measured = sparse_m > 0
+    dense[measured] = sparse_m[measured]
+    return dense.astype(np.float32)

@@ -3,6 +3,10 @@
 A model on disk is two files side by side: `<stem>.json` (the model config, with its type and its prior's type named) and
 `<stem>.msgpack` (the parameter pytree, `flax.serialization.msgpack_serialize`). Models shipped with the package
 live in `lipjax/weights/` and load by name, e.g. `load("lip-cnn-indoor")`.
+
+The stem is used as given: `save("out/smoke.v2", ...)` writes `out/smoke.v2.json` and `out/smoke.v2.msgpack`.
+`load` checks both files and raises ModelFileError (one line, naming the file and the fix) when either is
+unreadable, truncated, holds a bad config field, or when the parameters do not fit the config.
 """
 from __future__ import annotations
 
@@ -20,6 +24,15 @@ from lipjax.model import LIPConfig
 from lipjax.priors.network import NetworkPrior
 
 WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
+
+
+class ModelFileError(ValueError):
+    """A model file that cannot be used; the message names the file and the fix."""
+
+
+def _with_suffix(stem: pathlib.Path, suffix: str) -> pathlib.Path:
+    """stem + suffix, keeping any dots of the stem (Path.with_suffix would turn "smoke.v2" into "smoke.json")."""
+    return stem.with_name(stem.name + suffix)
 
 
 def _prior_types() -> dict[str, type]:
@@ -90,9 +103,9 @@ def save(stem: str | os.PathLike, config, params, metadata: dict | None = None) 
     stem = pathlib.Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
     params = jax.tree_util.tree_map(np.asarray, params)
-    _atomic_write(stem.with_suffix(".msgpack"), flax.serialization.msgpack_serialize(params))
+    _atomic_write(_with_suffix(stem, ".msgpack"), flax.serialization.msgpack_serialize(params))
     doc = {"config": config_to_dict(config), "metadata": metadata or {}}
-    _atomic_write(stem.with_suffix(".json"), json.dumps(doc, indent=2).encode())
+    _atomic_write(_with_suffix(stem, ".json"), json.dumps(doc, indent=2).encode())
 
 
 def available() -> list[str]:
@@ -102,11 +115,11 @@ def available() -> list[str]:
 
 def resolve(name_or_path: str | os.PathLike) -> pathlib.Path:
     """The stem of a shipped model name or of a path to `<stem>.json` / `<stem>.msgpack` / `<stem>`."""
-    s = str(name_or_path)
+    s = os.fspath(name_or_path)
     candidates = [WEIGHTS_DIR / s] if os.sep not in s and not s.endswith((".json", ".msgpack")) else []
-    candidates.append(pathlib.Path(s).with_suffix("") if s.endswith((".json", ".msgpack")) else pathlib.Path(s))
+    candidates.append(pathlib.Path(s.rsplit(".", 1)[0] if s.endswith((".json", ".msgpack")) else s))
     for stem in candidates:
-        if stem.with_suffix(".json").exists() and stem.with_suffix(".msgpack").exists():
+        if _with_suffix(stem, ".json").exists() and _with_suffix(stem, ".msgpack").exists():
             return stem
     raise ValueError(
         f"unknown model {s!r}: not a shipped model (available: {', '.join(available()) or 'none'}) "
@@ -114,11 +127,73 @@ def resolve(name_or_path: str | os.PathLike) -> pathlib.Path:
     )
 
 
+def _read_doc(stem: pathlib.Path) -> dict:
+    return json.loads(_with_suffix(stem, ".json").read_bytes())
+
+
+def metadata(name_or_path: str | os.PathLike) -> dict:
+    """The metadata a model was saved with (training data, validation metrics, ...), without loading its weights."""
+    return _read_doc(resolve(name_or_path)).get("metadata", {})
+
+
+def summary(name_or_path: str | os.PathLike) -> str:
+    """One line on what a model is, from its config: the type and what that type has (iterations, prox, initial
+    fill, depth range), e.g. "LIP, 3 iterations, network prox, z0 = linear fill, max depth 10 m"."""
+    config = config_from_dict(_read_doc(resolve(name_or_path))["config"])
+    if isinstance(config, LIPConfig):
+        prior = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
+        parts = ["LIP", f"{config.num_iterations} iterations", f"{prior} prox",
+                 f"z0 = {config.initial_estimate} fill"]
+    else:
+        model_type = {cls: name for name, cls in _model_types().items()}[type(config)]
+        parts = [f"{model_type} network (end to end)"]
+    return ", ".join(parts + [f"max depth {config.max_depth_m:g} m"])
+
+
 def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:
-    """(config, params, metadata) of a shipped model name or a saved model path."""
+    """(config, params, metadata) of a shipped model name or a saved model path; ModelFileError if unusable."""
     stem = resolve(name_or_path)
-    doc = json.loads(stem.with_suffix(".json").read_text())
-    config = config_from_dict(doc["config"])
-    params = flax.serialization.msgpack_restore(stem.with_suffix(".msgpack").read_bytes())
+    json_path, msgpack_path = _with_suffix(stem, ".json"), _with_suffix(stem, ".msgpack")
+    fix = ("reinstall lipjax" if stem.parent == WEIGHTS_DIR
+           else "save the model again (lipjax.model_io.save writes both files together)")
+    try:
+        doc = _read_doc(stem)
+        config = config_from_dict(doc["config"])
+    except (ValueError, TypeError, KeyError, AttributeError) as exc:  # JSONDecodeError is a ValueError
+        raise ModelFileError(f"{json_path}: not a valid lipjax model config ({_describe(exc)}); {fix}") from exc
+    try:
+        params = flax.serialization.msgpack_restore(msgpack_path.read_bytes())
+    except Exception as exc:  # noqa: BLE001 - msgpack raises several types for damaged data
+        raise ModelFileError(f"{msgpack_path}: cannot read the parameters, the file is damaged or truncated "
+                             f"({_describe(exc)}); {fix}") from exc
     params = jax.tree_util.tree_map(lambda a: np.asarray(a), params)
+    mismatch = _mismatch(config, params)
+    if mismatch:
+        raise ModelFileError(f"{msgpack_path} does not match {json_path.name} ({mismatch}): the two files come "
+                             f"from different models; {fix}")
     return config, params, doc.get("metadata", {})
+
+
+def _describe(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or "empty"
+    text = f"{type(exc).__name__}: {text}"
+    return text if len(text) <= 160 else text[:157] + "..."
+
+
+def _mismatch(config, params) -> str:
+    """What differs between the parameters a config makes and `params` ("" when they fit)."""
+    expected = jax.eval_shape(config.init, jax.random.key(0))
+    if not isinstance(params, dict) or set(params) != set(expected):
+        have = sorted(params) if isinstance(params, dict) else type(params).__name__
+        return f"the config makes parameters {sorted(expected)}, the file holds {have}"
+
+    def flat(tree):
+        return {".".join(str(getattr(k, "key", k)) for k in path): tuple(np.shape(leaf))
+                for path, leaf in jax.tree_util.tree_leaves_with_path(tree)}
+
+    want, have = flat(expected), flat(params)
+    for name in sorted(set(want) | set(have)):
+        if want.get(name) != have.get(name):
+            return (f"{name}: the config makes {want.get(name, 'nothing')}, the file holds "
+                    f"{have.get(name, 'nothing')}")
+    return ""

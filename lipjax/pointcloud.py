@@ -17,19 +17,31 @@ import pathlib
 import numpy as np
 
 from lipjax.data.sample import Intrinsics
+from lipjax.zbuffer import splat_nearest
 
 IntrinsicsLike = Intrinsics | np.ndarray
 
 
-def _intrinsics(intrinsics: IntrinsicsLike) -> Intrinsics:
+def as_intrinsics(intrinsics: IntrinsicsLike) -> Intrinsics:
+    """An Intrinsics from an Intrinsics, (fx, fy, cx, cy) or a 3x3 K (pixels), checked: fx, fy > 0, all finite.
+
+    Raises ValueError naming the numbers otherwise (e.g. all zeros would put every point at NaN).
+    """
     if isinstance(intrinsics, Intrinsics):
-        return intrinsics
-    k = np.asarray(intrinsics, dtype=np.float64)
-    if k.shape == (4,):
-        return Intrinsics(*map(float, k))
-    if k.shape != (3, 3):
-        raise ValueError(f"intrinsics must be an Intrinsics, (fx, fy, cx, cy) or a 3x3 K, got shape {k.shape}")
-    return Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]))
+        k = intrinsics
+    else:
+        a = np.asarray(intrinsics, dtype=np.float64)
+        if a.shape == (4,):
+            k = Intrinsics(*map(float, a))
+        elif a.shape == (3, 3):
+            k = Intrinsics(float(a[0, 0]), float(a[1, 1]), float(a[0, 2]), float(a[1, 2]))
+        else:
+            raise ValueError(f"intrinsics must be an Intrinsics, (fx, fy, cx, cy) or a 3x3 K, got shape {a.shape}")
+    values = (k.fx, k.fy, k.cx, k.cy)
+    if not (np.isfinite(values).all() and k.fx > 0 and k.fy > 0):
+        raise ValueError(f"intrinsics fx={k.fx:g} fy={k.fy:g} cx={k.cx:g} cy={k.cy:g}: the focal lengths fx, fy must "
+                         "be > 0 and all four finite (pixels); give the camera's fx fy cx cy (or its K)")
+    return k
 
 
 def _valid(depth: np.ndarray) -> np.ndarray:
@@ -44,7 +56,7 @@ def backproject(depth_m: np.ndarray, intrinsics: IntrinsicsLike) -> np.ndarray:
     depth = np.asarray(depth_m)
     if depth.ndim != 2:
         raise ValueError(f"depth must be (H, W) metres, got shape {depth.shape}")
-    k = _intrinsics(intrinsics)
+    k = as_intrinsics(intrinsics)
     v, u = np.nonzero(_valid(depth))
     z = depth[v, u].astype(np.float64)
     x = (u - k.cx) / k.fx * z
@@ -124,7 +136,7 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     if t.shape != (4, 4) or not np.allclose(t[3], [0, 0, 0, 1]):
         raise ValueError(f"T_cam_from_lidar must be a 4x4 rigid transform with last row [0 0 0 1], got {t.shape}")
     h, w = (int(s) for s in image_size)
-    k = _intrinsics(intrinsics)
+    k = as_intrinsics(intrinsics)
     cam = points[:, :3] @ t[:3, :3].T + t[:3, 3]
     z = cam[:, 2]
     keep = np.isfinite(cam).all(axis=1) & (z >= min_depth_m)
@@ -134,11 +146,4 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     pixel = row[inside].astype(np.int64) * w + col[inside].astype(np.int64)
     z = z[inside]
-    depth = np.zeros(h * w, np.float32)
-    if pixel.size:
-        order = np.lexsort((z, pixel))  # by pixel, then nearest first
-        pixel, z = pixel[order], z[order]
-        first = np.ones(pixel.size, bool)
-        first[1:] = pixel[1:] != pixel[:-1]
-        depth[pixel[first]] = z[first]
-    return depth.reshape(h, w)
+    return splat_nearest(pixel, z, (h, w))

@@ -124,14 +124,6 @@ def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, t
     assert (out > 0).all()
 
 
-def test_reproject_sparse_keeps_values_and_the_nearest_sample():
-    sparse = np.zeros((8, 8), np.float32)
-    sparse[0, 0], sparse[0, 1] = 5.0, 3.0   # same 2x2 block: one output pixel, the nearer wins
-    sparse[7, 7] = 1.25
-    small = cli.reproject_sparse(sparse, (4, 4))
-    assert small[0, 0] == 3.0 and small[3, 3] == 1.25 and np.count_nonzero(small) == 2
-
-
 @pytest.mark.parametrize("case, message", [
     ("unreadable_image", "Cannot read RGB image"),
     ("size_mismatch", "aligned"),
@@ -140,6 +132,10 @@ def test_reproject_sparse_keeps_values_and_the_nearest_sample():
     ("unknown_model", "unknown model 'no-such-model'"),
     ("too_many_iterations", "this model has 1 iterations"),
     ("ply_without_intrinsics", "intrinsics"),
+    ("zero_intrinsics", "--intrinsics 0 0 0 0: intrinsics fx=0 fy=0 cx=0 cy=0: the focal lengths fx, fy must be > 0"),
+    ("model_files_mismatch", "bad.msgpack does not match bad.json (the config makes parameters ['log_rho', 'prox'], the file holds ['encoder'])"),
+    ("model_json_bad_field", "bad.json: not a valid lipjax model config (TypeError: "),
+    ("model_file_truncated", "bad.msgpack: cannot read the parameters, the file is damaged or truncated"),
 ])
 def test_user_errors_are_one_line_without_traceback(case, message, model, frame, tmp_path, capsys):
     rgb, depth, model_arg, extra = frame["rgb"], frame["npy"], model[0], []
@@ -160,18 +156,84 @@ def test_user_errors_are_one_line_without_traceback(case, message, model, frame,
         extra = ["--iterations", "2"]
     elif case == "ply_without_intrinsics":
         extra = ["--ply", str(tmp_path / "x.ply")]
+    elif case == "zero_intrinsics":
+        extra = ["--ply", str(tmp_path / "x.ply"), "--intrinsics", "0", "0", "0", "0"]
+    elif case.startswith("model_"):
+        model_arg = _broken_model(case, model, tmp_path / "bad")
     rc = cli.main(["complete", "--rgb", str(rgb), "--depth", str(depth), "--model", model_arg,
                    "--out", str(tmp_path / "out.npy"), *extra])
     err = capsys.readouterr().err
     assert rc == 1
     assert len(err.strip().splitlines()) == 1 and err.startswith("lipjax: error: "), err
     assert message in err and "Traceback" not in err
-    assert not (tmp_path / "out.npy").exists()
+    assert not (tmp_path / "out.npy").exists() and not (tmp_path / "x.ply").exists()
 
 
-def test_usage_error_returns_2(capsys):
+def _broken_model(case, model, stem):
+    """Writes stem.json + stem.msgpack broken as `case` says; returns the stem."""
+    good = pathlib.Path(model[0])
+    doc = json.loads(good.with_name("tiny.json").read_text())
+    params = good.with_name("tiny.msgpack").read_bytes()
+    if case == "model_files_mismatch":  # parameters of another kind of model
+        model_io.save(stem, CONFIG, {"encoder": {"kernel": np.zeros((3, 3), np.float32)}})
+        return str(stem)
+    if case == "model_json_bad_field":
+        doc["config"]["num_iterationz"] = 2
+    if case == "model_file_truncated":
+        params = params[: len(params) // 2]
+    stem.with_name("bad.json").write_text(json.dumps(doc))
+    stem.with_name("bad.msgpack").write_bytes(params)
+    return str(stem)
+
+
+def test_usage_error_returns_2_with_one_line(capsys):
     assert cli.main(["complete", "--rgb", "a.png"]) == 2
-    assert "required" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert _one_error_line(err).startswith("lipjax complete: error: the following arguments are required")
+
+
+def _one_error_line(err, prog="lipjax"):
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith(f"{prog}") and "Traceback" not in err, err
+    return lines[0]
+
+
+def test_version(capsys):
+    with pytest.raises(SystemExit) as exit_:
+        cli.build_parser().parse_args(["--version"])
+    assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"lipjax {lipjax.__version__}"
+    assert cli.main(["--version"]) == 0
+
+
+def test_mixed_png_npy_folder_fails_before_writing_and_names_the_odd_file(model, tmp_path, capsys):
+    (tmp_path / "depth").mkdir()
+    for i, name in enumerate(("a.png", "b.png", "c.npy")):
+        rgb, sparse = _frame(seed=i)
+        _write_frame(tmp_path / "rgb", rgb, sparse, rgb_name=f"{name[0]}.png", depth_name="../depth/" + name)
+    rc = cli.main(["complete", "--rgb", str(tmp_path / "rgb"), "--depth", str(tmp_path / "depth"), "--depth-scale",
+                   "256", "--model", model[0], "--out", str(tmp_path / "out")])
+    line = _one_error_line(capsys.readouterr().err)
+    assert rc == 1 and "mixes .png and .npy" in line and "c.npy" in line and "a.png" not in line
+    assert not (tmp_path / "out").exists()
+
+
+def test_large_frame_prints_a_max_side_hint(model, frame, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(lipjax.inference, "LARGE_FRAME_PIXELS", H * W - 1)
+    assert _complete(model, frame, tmp_path / "out.npy") == 0
+    assert "--max-side" in _one_error_line(capsys.readouterr().err, "lipjax: warning:")
+    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16") == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_evaluate_lidar_sampler_on_a_folder_without_intrinsics_asks_for_them(tmp_path, capsys):
+    rgb, sparse = _frame()
+    (tmp_path / "data" / "depth").mkdir(parents=True)
+    _write_frame(tmp_path / "data" / "rgb", rgb, sparse, rgb_name="0.png", depth_name="../depth/0.npy")
+    rc = cli.main(["evaluate", "--method", "nearest", "--data", str(tmp_path / "data"), "--sampler", "lidar:hdl64",
+                   "--max-depth-m", "10", "--quiet"])
+    line = _one_error_line(capsys.readouterr().err)
+    assert rc == 1 and "lidar:hdl64 simulates a LiDAR and needs the camera intrinsics" in line
+    assert "--intrinsics fx fy cx cy" in line and "intrinsics.txt" in line
 
 
 def test_subprocess_error_has_no_traceback(tmp_path):
@@ -188,10 +250,14 @@ def test_subprocess_error_has_no_traceback(tmp_path):
     assert result.stderr.startswith("lipjax: error: ") and "Traceback" not in result.stderr, result.stderr
 
 
-def test_models_command(capsys):
+def test_models_command_says_what_each_model_is(capsys):
     assert cli.main(["models"]) == 0
     out = capsys.readouterr().out
     assert all(name in out for name in lipjax.available_models()) and out.strip()
+    assert "None" not in out
+    for line in out.splitlines():
+        assert ("LIP, " in line and " iterations, " in line) or "network (end to end)" in line, line
+        assert " max depth " in line and line.split(" max depth ")[1].split()[0].replace(".", "").isdigit(), line
 
 
 def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
@@ -202,15 +268,6 @@ def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
     assert rc == 0
     assert "| method | rmse_m | mae_m |" in out and f"| {model[0]} |" in out and "| nearest |" in out
     assert set(json.loads((tmp_path / "r.json").read_text())) == {model[0], "nearest"}
-
-
-def test_train_delegates_to_experiments_train(monkeypatch):
-    import experiments.train
-
-    seen = []
-    monkeypatch.setattr(experiments.train, "main", lambda argv: seen.append(argv))
-    assert cli.main(["train", "--config", "smoke", "--set", "g_steps=1"]) == 0
-    assert seen == [["--config", "smoke", "--set", "g_steps=1"]]
 
 
 def test_export_command_writes_a_deserializable_file(model, tmp_path):

@@ -105,3 +105,29 @@ def test_host_initial_estimate_untrained_model_returns_that_fill(kind):
     np.testing.assert_allclose(model(rgb, sparse), expected, atol=1e-5)
     with pytest.raises(ValueError, match="computed on the host"):
         config.apply(model.params, rgb, sparse)
+
+
+def test_save_keeps_a_dotted_stem_exactly(tmp_path, completer):
+    model_io.save(tmp_path / "smoke.v2", CONFIG, completer.params)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["smoke.v2.json", "smoke.v2.msgpack"]
+    assert lipjax.load_model(tmp_path / "smoke.v2").config == CONFIG
+    assert lipjax.load_model(tmp_path / "smoke.v2.msgpack").config == CONFIG
+
+
+def test_complete_takes_any_method_name():
+    rgb, sparse = _inputs()
+    np.testing.assert_array_equal(lipjax.complete(rgb, sparse, model="linear"),
+                                  lipjax.complete(rgb, sparse, model=inference.get_completer("linear")))
+    assert lipjax.complete(rgb, sparse, model="nearest").shape == sparse.shape
+
+
+def test_reproject_sparse_and_complete_frame_keep_measured_values(completer):
+    sparse = np.zeros((8, 8), np.float32)
+    sparse[0, 0], sparse[0, 1] = 5.0, 3.0   # same 2x2 block: one output pixel, the nearer wins
+    sparse[7, 7] = 1.25
+    small = inference.reproject_sparse(sparse, (4, 4))
+    assert small[0, 0] == 3.0 and small[3, 3] == 1.25 and np.count_nonzero(small) == 2
+    rgb, sparse = _inputs(h=24, w=32)
+    dense = inference.complete_frame(inference.get_completer("linear"), rgb, sparse, max_side=16)
+    assert dense.shape == (24, 32) and dense.dtype == np.float32
+    np.testing.assert_array_equal(dense[sparse > 0], sparse[sparse > 0])

@@ -10,11 +10,15 @@ Folder layout (frames matched by file stem):
 
 Depth scales of common sensors (raw PNG value per metre): KITTI 256, NYU / Kinect / RealSense 1000,
 TUM RGB-D 5000. A PNG depth has no unit in it, so the scale must be given: there is no default.
+
+Single frames, as the command line reads and writes them: `read_frame` (an RGB image and its aligned sparse
+depth, checked), `write_depth` (.npy metres, 16-bit .png at a scale, or a .color.png picture).
 """
 from __future__ import annotations
 
 import os
 import re
+import warnings
 from pathlib import Path
 
 import cv2
@@ -22,10 +26,12 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.sample import Intrinsics, Sample
+from lipjax.pointcloud import as_intrinsics
 
 RGB_SUFFIXES = (".png", ".jpg", ".jpeg")
 DEPTH_SUFFIXES = (".png", ".npy")
 KNOWN_DEPTH_SCALES = {"kitti": 256.0, "nyu": 1000.0, "tum": 5000.0}
+OUT_FORMATS = ("npy", "png", "color.png")
 
 FOLDER_LAYOUT = """\
 <root>/rgb/<stem>.png|.jpg
@@ -102,12 +108,80 @@ def read_intrinsics_txt(path: str | os.PathLike) -> Intrinsics:
         values = [float(tok) for tok in Path(path).read_text().split()]
     except (OSError, ValueError) as exc:
         raise dataset_error(f"Cannot read intrinsics ({exc})", path) from exc
-    if len(values) == 4:
-        return Intrinsics(*values)
-    if len(values) == 9:
-        k = np.asarray(values).reshape(3, 3)
-        return Intrinsics(float(k[0, 0]), float(k[1, 1]), float(k[0, 2]), float(k[1, 2]))
-    raise dataset_error(f"Intrinsics file must hold 4 numbers (fx fy cx cy) or 9 (K), found {len(values)}", path)
+    if len(values) not in (4, 9):
+        raise dataset_error(f"Intrinsics file must hold 4 numbers (fx fy cx cy) or 9 (K), found {len(values)}", path)
+    try:
+        return as_intrinsics(np.asarray(values).reshape(3, 3) if len(values) == 9 else values)
+    except ValueError as exc:
+        raise dataset_error(str(exc), path) from exc
+
+
+def read_frame(rgb_path: str | os.PathLike, depth_path: str | os.PathLike,
+               scale: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """(rgb (H, W, 3) uint8, sparse (H, W) float32 metres) of one frame, checked: the depth is a .npy (metres)
+    or a 16-bit .png with its `scale` (value per metre), aligned with the RGB image and not empty."""
+    rgb_path, depth_path = Path(rgb_path), Path(depth_path)
+    rgb = read_rgb(rgb_path)
+    suffix = depth_path.suffix.lower()
+    if suffix == ".png" and scale is None:
+        raise ValueError(f"{depth_path}: a PNG depth map has no unit; give its scale, --depth-scale S (metres = "
+                         "value / S): KITTI 256, NYU 1000, TUM 5000")
+    if suffix not in DEPTH_SUFFIXES:
+        raise ValueError(f"{depth_path}: unsupported depth format {suffix!r} (use a 16-bit .png with --depth-scale, "
+                         "or .npy in metres)")
+    sparse = read_depth(depth_path, scale if suffix == ".png" else None)
+    if sparse.shape != rgb.shape[:2]:
+        raise ValueError(f"{depth_path}: sparse depth is {sparse.shape[0]}x{sparse.shape[1]} but the RGB image "
+                         f"{rgb_path} is {rgb.shape[0]}x{rgb.shape[1]}; the depth must be aligned with the RGB image "
+                         "pixel for pixel (project your LiDAR into the camera: lipjax.pointcloud.project_lidar_to_depth)")
+    if not (sparse > 0).any():
+        raise ValueError(f"{depth_path}: the sparse depth map is empty (no pixel > 0); nothing to complete from")
+    return rgb, sparse
+
+
+def output_format(path: str | os.PathLike) -> str:
+    """The format an output file name asks for: "npy", "png" or "color.png" (ValueError otherwise)."""
+    name = Path(path).name.lower()
+    for fmt in ("color.png", "npy", "png"):
+        if name.endswith("." + fmt):
+            return fmt
+    raise ValueError(f"{path}: unknown output extension; use .npy (metres), .png (16-bit, scale S) or .color.png "
+                     "(picture)")
+
+
+def write_depth(path: str | os.PathLike, dense_m: np.ndarray, fmt: str, png_scale: float,
+                color_range_m: tuple[float, float]) -> None:
+    """Writes (H, W) metres as fmt: "npy" (float32 metres), "png" (16-bit, value = round(metres * png_scale);
+    depths that do not fit are clipped, with a warning) or "color.png" (turbo picture over color_range_m)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if fmt == "npy":
+        np.save(path, np.asarray(dense_m, np.float32))
+    elif fmt == "color.png":
+        from lipjax import viz
+
+        viz.write_png(path, viz.colorize_depth(dense_m, *color_range_m))
+    elif fmt == "png":
+        raw = np.round(np.asarray(dense_m, np.float64) * png_scale)
+        if raw.max() > 65535:
+            warnings.warn(f"{path}: depth above {65535 / png_scale:.1f} m does not fit a 16-bit PNG at scale "
+                          f"{png_scale:g}; clipped (use a smaller --depth-scale or .npy)", stacklevel=2)
+        if not cv2.imwrite(os.fspath(path), np.clip(raw, 0, 65535).astype(np.uint16)):
+            raise OSError(f"cannot write {path}")
+    else:
+        raise ValueError(f"unknown depth output format {fmt!r}; one of {OUT_FORMATS}")
+
+
+def check_one_depth_format(depth_paths: list[Path]) -> None:
+    """Raises DatasetError naming the odd files when a folder mixes .png and .npy depth (their units differ)."""
+    by_suffix: dict[str, list[Path]] = {}
+    for path in depth_paths:
+        by_suffix.setdefault(path.suffix.lower(), []).append(path)
+    if len(by_suffix) > 1:
+        odd = min(by_suffix.values(), key=len)
+        names = ", ".join(p.name for p in odd[:3]) + (f" and {len(odd) - 3} more" if len(odd) > 3 else "")
+        raise dataset_error(f"Depth folder mixes .png and .npy files (units differ: scaled integers vs metres); "
+                            f"convert or move away the odd one(s): {names}, in", odd[0].parent)
 
 
 def _list(directory: Path, suffixes: tuple[str, ...]) -> dict[str, Path]:

@@ -23,6 +23,7 @@ from typing import Protocol
 import numpy as np
 
 from lipjax.data.sample import Sample
+from lipjax.zbuffer import nearest_per_cell
 
 # A noisy sample must stay > 0: 0 means "no sample" and would silently drop the point.
 MIN_SPARSE_DEPTH_M = 1e-3
@@ -209,10 +210,7 @@ class LidarSampler:
             return np.zeros(sample.shape, dtype=np.float32)
         column = column - column.min()
         cell = beam * (int(column.max()) + 1) + column
-        order = np.lexsort((idx, cost, cell))  # per cell: nearest to the centre first; ties by pixel index
-        first = np.ones(order.size, dtype=bool)
-        first[1:] = cell[order][1:] != cell[order][:-1]
-        chosen = idx[order[first]]
+        chosen = idx[nearest_per_cell(cell, cost, tiebreak=idx)]  # per cell: nearest to the centre
         if self.dropout > 0 and chosen.size:
             chosen = chosen[example_rng(seed, sample.id).random(chosen.size) >= self.dropout]
         out = np.zeros(sample.depth.size, dtype=np.float32)
