@@ -1,0 +1,98 @@
+"""lipjax.uncertainty: the expected-error formula, its ordering guarantees, units and the zero-out."""
+import math
+
+import numpy as np
+import pytest
+from scipy.stats import spearmanr
+
+from lipjax import uncertainty
+from lipjax.uncertainty import ABOVE_GAIN, SPREAD_GAIN, drop_uncertain, expected_error
+
+
+def _grid_frame():
+    """21x21, 9 samples on a 10-pixel grid: spacing sqrt(21 * 21 / 9) = 7 px; column 0 at 2 m, the rest 4 m."""
+    sparse = np.zeros((21, 21), np.float32)
+    for r in (0, 10, 20):
+        for c in (0, 10, 20):
+            sparse[r, c] = 2.0 if c == 0 else 4.0
+    return sparse, np.full(sparse.shape, 3.0, np.float32)
+
+
+def test_value_by_hand_and_zero_on_measured_pixels():
+    sparse, depth = _grid_frame()
+    assert uncertainty.sample_spacing(sparse) == pytest.approx(7.0)
+    u = expected_error(sparse, depth)
+    # (5, 5): nearest sample at sqrt(50) px = sqrt(50) / 7 spacings; the 29-px window sees both depths: spread 2 m
+    assert u[5, 5] == pytest.approx(SPREAD_GAIN * math.sqrt(50) / 7 * 2.0, rel=1e-5)
+    assert (u[sparse > 0] == 0).all() and u.dtype == np.float32
+
+
+def test_monotone_in_distance_to_the_samples():
+    sparse, depth = _grid_frame()
+    u = expected_error(sparse, depth)
+    assert (np.diff(u[0, 0:6]) > 0).all() and (np.diff(u[0:6, 0]) > 0).all()  # walking away from sample (0, 0)
+    assert u[5, 5] > u[3, 3] > u[1, 1] > 0
+
+
+def _lidar_frame():
+    """60x80: scan lines on every 2nd row from row 30 down, depth 5 m left half and 20 m right half;
+    the completion extends up to 100 m above the lines (a 'tent')."""
+    sparse = np.zeros((60, 80), np.float32)
+    sparse[30::2, :40] = 5.0
+    sparse[30::2, 40:] = 20.0
+    depth = np.where(np.arange(80) < 40, 5.0, 20.0)[None, :].repeat(60, 0).astype(np.float32)
+    depth[:30] = 100.0
+    return sparse, depth
+
+
+def test_above_the_top_scan_line_is_the_most_uncertain():
+    sparse, depth = _lidar_frame()
+    u = expected_error(sparse, depth)
+    s = uncertainty.sample_spacing(sparse)
+    above = np.arange(60)[:, None].repeat(80, 1) < 30 - s
+    below = np.arange(60)[:, None].repeat(80, 1) >= 30
+    assert u[above].min() >= u[~above].max()
+    assert u[above].min() >= ABOVE_GAIN * 100.0 and u[below].max() < u[above].min()
+
+
+def test_no_support_in_a_column_range_counts_as_above():
+    sparse, depth = _lidar_frame()
+    sparse[:, 60:] = 0  # a beam-less block of columns (e.g. the top beams hit the sky there)
+    u = expected_error(sparse, depth)
+    assert u[45, 75] >= u[30:, :56].max() and u[45, 75] >= ABOVE_GAIN * depth[45, 75]
+
+
+def test_units_are_those_of_the_depth():
+    sparse, depth = _lidar_frame()
+    np.testing.assert_allclose(expected_error(sparse * 1000, depth * 1000), expected_error(sparse, depth) * 1000,
+                               rtol=1e-5)
+
+
+def test_drop_uncertain_sets_depth_to_zero_above_the_threshold():
+    depth = np.array([[1.0, 2.0], [3.0, 4.0]], np.float32)
+    u = np.array([[0.1, 0.5], [0.51, 2.0]], np.float32)
+    np.testing.assert_array_equal(drop_uncertain(depth, u, 0.5), [[1.0, 2.0], [0.0, 0.0]])
+    np.testing.assert_array_equal(drop_uncertain(depth, u, 10.0), depth)
+    with pytest.raises(ValueError, match="max_uncertainty"):
+        drop_uncertain(depth, u, -1.0)
+
+
+def test_bad_shapes_and_empty_samples_are_errors():
+    sparse, depth = _grid_frame()
+    with pytest.raises(ValueError, match="same"):
+        expected_error(sparse, depth[:-1])
+    with pytest.raises(ValueError, match="no samples"):
+        expected_error(np.zeros_like(sparse), depth)
+
+
+def test_ranks_the_linear_fill_error_on_a_synthetic_val_frame():
+    from lipjax.baselines.interpolate import linear_fill
+    from lipjax.data.sampling import UniformSampler
+    from lipjax.data.synthetic import SyntheticDataset
+
+    sample = SyntheticDataset("indoor", "val", height=96, width=128)[0]
+    sparse = UniformSampler(100)(sample)
+    dense = linear_fill(sparse)
+    scored = sample.valid & (sparse == 0)
+    rho = spearmanr(expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored])[0]
+    assert rho > 0.3
