@@ -17,10 +17,12 @@ import argparse
 import dataclasses
 import json
 import pathlib
+import sys
 
 import numpy as np
 
 from experiments.common import line_plot, synthetic_outdoor_test
+from lipjax.console import ArgumentParser, positive_int, positive_int_list, run_main
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
@@ -28,6 +30,8 @@ from lipjax.inference import load_model
 from lipjax.metrics import MetricAggregator, compute_metrics
 from lipjax.model_io import available, load
 from lipjax.utils import enable_compilation_cache
+
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
 
 
 @dataclasses.dataclass(frozen=True)
@@ -87,12 +91,12 @@ def _finished(path: str, config) -> bool:
 
 
 def main(argv=None) -> dict:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", choices=("indoor", "outdoor"), default="indoor")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--models", help="comma-separated models (default: shipped lip-cnn/lip-ad for the scene)")
-    p.add_argument("--train-k", help="also train models with these iteration counts, e.g. 1,2,3,5")
-    p.add_argument("--train-steps", type=int, default=300)
+    p.add_argument("--train-k", type=positive_int_list, help="also train models with these iteration counts, e.g. 1,2,3,5")
+    p.add_argument("--train-steps", type=positive_int, default=300)
     p.add_argument("--out", default="out/convergence")
     args = p.parse_args(argv)
     enable_compilation_cache()
@@ -114,7 +118,7 @@ def main(argv=None) -> dict:
     lines.append("|---|" + "---:|" * (len(lines[0].split("|")) - 3))
     lines += [f"| {m} | " + " | ".join(f"{v:.4f}" for v in c) + " |" for m, c in curves.items()]
     if args.train_k:
-        ks = [int(k) for k in args.train_k.split(",")]
+        ks = args.train_k
         paths = train_k_models(args.scene, ks, args.train_steps, out)
         trained = {k: mae_per_iteration(load_model(paths[k]), dataset, sampler, config.limit, config.seed,
                                         protocol.max_depth_m)[-1] for k in ks}
@@ -135,4 +139,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

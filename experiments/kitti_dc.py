@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import pathlib
+import sys
 
 from experiments.common import (
     evaluate_methods,
@@ -23,10 +24,13 @@ from experiments.common import (
     synthetic_outdoor_test,
     write_results,
 )
+from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
+
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
 
 COLUMNS = ("rmse_mm", "mae_mm", "irmse_1_per_km", "imae_1_per_km", "mae_sampled_m", "ms_per_frame")
 
@@ -43,11 +47,11 @@ VARIANTS = {"default": Config(), "full": Config(limit=None), "smoke": Config(lim
 
 
 def main(argv=None) -> dict:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--data-dir", help="KITTI depth completion root holding depth_selection/val_selection_cropped")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--methods", help="comma-separated method names (default: all available for outdoor scenes)")
-    p.add_argument("--limit", type=int)
+    p.add_argument("--limit", type=positive_int)
     p.add_argument("--out", default="out/kitti_dc")
     args = p.parse_args(argv)
     enable_compilation_cache()
@@ -88,4 +92,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

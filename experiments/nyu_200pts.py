@@ -14,13 +14,17 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import pathlib
+import sys
 
 from experiments.common import evaluate_methods, load_methods, parameter_counts, qualitative_figure, write_results
+from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.data.protocols import ProtocolView, get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
+
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
 
 COLUMNS = ("rmse_m", "rel", "delta1_pct", "delta2_pct", "delta3_pct", "mae_m", "mae_sampled_m", "ms_per_frame")
 
@@ -44,14 +48,14 @@ VARIANTS = {
 
 
 def main(argv=None) -> dict:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--data-dir", help="NYU Depth v2 h5 root (nyudepthv2/{train,val}/<scene>/<n>.h5)")
     p.add_argument("--protocol", choices=("paper", "ma"), default="paper")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--methods", help="comma-separated method names (default: all available)")
-    p.add_argument("--limit", type=int, help="evaluate only the first N frames")
+    p.add_argument("--limit", type=positive_int, help="evaluate only the first N frames")
     p.add_argument("--train", action="store_true", help="retrain LIP+CNN and LIP+AD first (see --train-steps)")
-    p.add_argument("--train-steps", type=int, default=200, help="G steps for LIP+CNN and adversarial steps for LIP+AD")
+    p.add_argument("--train-steps", type=positive_int, default=200, help="G steps for LIP+CNN and adversarial steps for LIP+AD")
     p.add_argument("--out", default="out/nyu_200pts")
     args = p.parse_args(argv)
     enable_compilation_cache()
@@ -111,4 +115,4 @@ def _retrain(out: pathlib.Path, steps: int) -> list[str]:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

@@ -11,13 +11,17 @@ import argparse
 import dataclasses
 import json
 import pathlib
+import sys
 
 from experiments.common import evaluate_methods, line_plot, synthetic_outdoor_test
+from lipjax.console import ArgumentParser, run_main
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
+
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
 
 
 @dataclasses.dataclass(frozen=True)
@@ -32,7 +36,7 @@ VARIANTS = {"default": Config(), "smoke": Config(point_counts=(50, 200), limit=1
 
 
 def main(argv=None) -> dict:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", choices=("indoor", "outdoor"), default="indoor")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--out", default="out/sample_rate")
@@ -67,4 +71,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

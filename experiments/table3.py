@@ -15,14 +15,18 @@ import argparse
 import dataclasses
 import json
 import pathlib
+import sys
 
 from experiments.common import evaluate_methods, line_plot, synthetic_outdoor_test
+from lipjax.console import ArgumentParser, run_main
 from lipjax.data.protocols import ProtocolView, get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.evaluate import markdown_table
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
+
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
 
 COLUMNS = ("rmse_m", "rel", "delta1_pct", "mae_m", "ms_per_frame")
 
@@ -51,7 +55,7 @@ def plot_blocks(doc: dict, point_counts, out: pathlib.Path) -> list[pathlib.Path
 
 
 def main(argv=None) -> dict:
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--kitti-odometry-dir", help="KITTI odometry root (sequences/<SS>/{image_2,velodyne,calib.txt})")
     p.add_argument("--sequences", default="08", help="odometry sequences to evaluate, comma-separated")
@@ -96,4 +100,4 @@ def main(argv=None) -> dict:
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

@@ -75,16 +75,6 @@ def _depth_scale(text: str) -> float:
     return value
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
-    return value
-
-
 def _intrinsics_from_args(args):
     """The checked Intrinsics of --intrinsics / --intrinsics-file, or None when neither was given."""
     from lipjax.data.folder import read_intrinsics_txt
@@ -297,10 +287,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output (default 256)")
     c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path "
                    "(also any lipjax.methods name, e.g. ip_basic)")
-    c.add_argument("--iterations", type=_positive_int, default=None, metavar="K", help="run the first K ADMM iterations")
+    c.add_argument("--iterations", type=console.positive_int, default=None, metavar="K", help="run the first K ADMM iterations")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, default=None, help="per-frame format with folder inputs")
-    c.add_argument("--max-side", type=_positive_int, default=None, metavar="N", help="run larger frames downsized to this longer side")
+    c.add_argument("--max-side", type=console.positive_int, default=None, metavar="N", help="run larger frames downsized to this longer side")
     c.add_argument("--color-range", type=float, nargs=2, default=None, metavar=("MIN_M", "MAX_M"),
                    help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
     c.add_argument("--ply", default=None, help="also write a coloured point cloud (.ply; a folder with folder inputs)")
@@ -314,11 +304,11 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
                    help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
                         "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
-    e.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
+    e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
     e.add_argument("--data", default="synthetic-indoor",
                    help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ (lipjax.data.folder layout)")
     e.add_argument("--split", default="test", choices=("train", "val", "test"), help="synthetic split")
-    e.add_argument("--size", type=_positive_int, nargs=2, default=None, metavar=("H", "W"), help="synthetic render size (default 256 320)")
+    e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"), help="synthetic render size (default 256 320)")
     e.add_argument("--sampler", default="uniform:200", help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling)")
     e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS), help="named crop/resize + depth range applied to each frame (lipjax.data.protocols)")
     e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="for PNG ground truth in FOLDER")
@@ -327,7 +317,7 @@ def build_parser() -> argparse.ArgumentParser:
     intr.add_argument("--intrinsics-file", default=None, metavar="F")
     e.add_argument("--min-depth-m", type=float, default=None)
     e.add_argument("--max-depth-m", type=float, default=None, help="default: the protocol's (10 indoor, 80 outdoor)")
-    e.add_argument("--limit", type=_positive_int, default=None, metavar="N", help="evaluate the first N frames only")
+    e.add_argument("--limit", type=console.positive_int, default=None, metavar="N", help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", default=None, help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
     e.add_argument("--json", default=None, metavar="FILE", help="also write all results as JSON")
@@ -336,10 +326,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     x = sub.add_parser("export", help="export a model as StableHLO (jax.export) for a fixed input shape")
     x.add_argument("--model", default=None)
-    x.add_argument("--iterations", type=_positive_int, default=None, metavar="K")
-    x.add_argument("--height", type=_positive_int, required=True)
-    x.add_argument("--width", type=_positive_int, required=True)
-    x.add_argument("--batch", type=_positive_int, default=1)
+    x.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
+    x.add_argument("--height", type=console.positive_int, required=True)
+    x.add_argument("--width", type=console.positive_int, required=True)
+    x.add_argument("--batch", type=console.positive_int, default=1)
     x.add_argument("--platforms", default=None, help="comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE.stablehlo")
     x.add_argument("--quiet", action="store_true")
@@ -352,13 +342,13 @@ def build_parser() -> argparse.ArgumentParser:
         "render", help="render synthetic frames into shard files (lipjax.data.rendered) in worker processes")
     r.add_argument("--kind", required=True, choices=("indoor", "outdoor"))
     r.add_argument("--split", default="train", choices=("train", "val", "test"))
-    r.add_argument("--count", type=_positive_int, required=True, help="frames 0 .. N-1 of the split")
+    r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
     r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
-    r.add_argument("--height", type=_positive_int, default=None, help="full frame (default 256x320 indoor, 128x416 outdoor)")
-    r.add_argument("--width", type=_positive_int, default=None)
-    r.add_argument("--window", type=_positive_int, nargs=2, default=None, metavar=("H", "W"),
+    r.add_argument("--height", type=console.positive_int, default=None, help="full frame (default 256x320 indoor, 128x416 outdoor)")
+    r.add_argument("--width", type=console.positive_int, default=None)
+    r.add_argument("--window", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="store one HxW window per frame, rendered directly at the training crop size")
-    r.add_argument("--workers", type=_positive_int, default=None, help="processes (default: every core)")
+    r.add_argument("--workers", type=console.positive_int, default=None, help="processes (default: every core)")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=_cmd_data_render)
     return parser

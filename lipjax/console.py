@@ -4,8 +4,10 @@ A problem the user can fix (a bad argument, an unreadable or mismatched file, ..
 "PROG: error: ...", with exit status 1; warnings as one line "PROG: warning: ..."; argparse usage errors as one
 line too, with exit status 2. LIPJAX_DEBUG=1 shows the Python traceback instead.
 
+    PROG = f"python -m {__spec__.name}"          # the same name when imported and when run with -m
+    ...
     if __name__ == "__main__":
-        sys.exit(run_main("python -m experiments.table3", main))
+        sys.exit(run_main(PROG, main))
 """
 from __future__ import annotations
 
@@ -29,6 +31,25 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def positive_int(text: str) -> int:
+    """argparse type: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
+    return value
+
+
+def positive_int_list(text: str) -> list[int]:
+    """argparse type: comma-separated integers >= 1, e.g. "1,2,3,5"."""
+    try:
+        return [positive_int(item) for item in text.split(",")]
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected comma-separated positive integers, e.g. 1,2,3, got {text!r}") from None
 
 
 def one_line(exc: BaseException) -> str:

@@ -3,9 +3,11 @@ import json
 
 import jax
 import numpy as np
+import pytest
 
 from experiments import convergence, kitti_dc, nyu_200pts, sample_rate, table3
 from lipjax import model_io
+from lipjax.console import run_main
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 
@@ -68,3 +70,17 @@ def test_convergence_reuses_only_a_finished_k_model_of_the_same_config(tmp_path)
     assert not convergence._finished(path, other_k)
     model_io.save(path, SMOKE.model, params, {"train_config": SMOKE.name, "steps": SMOKE.total_steps - 1})
     assert not convergence._finished(path, SMOKE)  # a run stopped early
+
+
+@pytest.mark.parametrize("module, argv, status, message", [
+    (kitti_dc, ["--variant", "smoke", "--data-dir", "{tmp}/no-kitti"], 1, "KITTI val_selection_cropped/image not found"),
+    (kitti_dc, ["--variant", "nope"], 2, "argument --variant: invalid choice: 'nope'"),
+    (convergence, ["--variant", "smoke", "--train-k", "x"], 2, "--train-k: expected comma-separated positive integers"),
+    (nyu_200pts, ["--variant", "smoke", "--limit", "0"], 2, "--limit: expected a positive integer, got 0"),
+    (table3, ["--variant", "smoke", "--kitti-odometry-dir", "{tmp}/no-odometry"], 1, "KITTI odometry root not found"),
+])
+def test_bad_arguments_give_one_line(module, argv, status, message, tmp_path, capsys):
+    argv = [a.format(tmp=tmp_path) for a in argv] + ["--out", str(tmp_path / "out")]
+    assert run_main(module.PROG, module.main, argv) == status
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith(f"{module.PROG}: error: ") and message in lines[0], lines
