@@ -128,6 +128,87 @@ LIP_FAST_INDOOR = dataclasses.replace(
     g_steps=8000, learning_rate=1e-3, warmup_steps=200, eval_every=500, checkpoint_every=100,
 )
 
+# ---- The paper's data sets and your own (lipjax.data.sources). Each run reads its frames from --set data.root=DIR:
+#     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
+# Runtimes on one GPU are ESTIMATES, not measurements: no GPU was lent to the session that wrote these configs.
+# They assume GPU_IMAGES_PER_S training images/s at 256x320 (scaled by pixel count for other sizes), which needs the
+# grain loader with ~16 workers (benchmarks/train_throughput.py gives the per-worker rate of each source); the one
+# GPU measurement so far was input-bound at 14-25 images/s with the old thread loader (issue 14).
+GPU_IMAGES_PER_S = 400
+NYU_PAPER_DATA = DataConfig(
+    source="nyu_h5", protocol="nyu_paper", crop=None, train_sampler="uniform:200", val_sampler="uniform:200",
+    val_images=64, num_workers=8,
+)
+KITTI_PAPER_DATA = DataConfig(
+    source="kitti_dc", protocol="kitti_paper", crop=None, train_sampler="input", val_sampler="input",
+    val_images=32, num_workers=8,
+)
+TARTANAIR_DATA = dataclasses.replace(NYU_PAPER_DATA, source="tartanair", protocol="tartanair")
+FOLDER_DATA = DataConfig(
+    source="folder", crop=(128, 160), train_sampler="uniform:200|uniform:500|bernoulli:200",
+    val_sampler="uniform:200", val_images=32, num_workers=2,
+)
+
+# lip_cnn_nyu. Protocol nyu_paper: NYU v2 h5 frames (Ma et al. layout), centre crop 464x580, resize 256x320; depth
+# 0-10 m. Sampler: 200 uniform ground-truth pixels (the paper's setting), keyed by frame id. Budget: 20000 steps x
+# batch 16 = 320k images (~6.7 epochs of the 47584 training frames), L1 loss from the linear fill. Expected
+# runtime on one GPU: ~13 min at GPU_IMAGES_PER_S (estimate). Source nyu_tfds reads a prepared TFDS instead:
+# --set data.source=nyu_tfds --set data.root=TFDS_DATA_DIR.
+LIP_CNN_NYU = dataclasses.replace(
+    LIP_CNN_INDOOR, name="lip-cnn-nyu", data=NYU_PAPER_DATA, batch_size=16, g_steps=20000, warmup_steps=500,
+    eval_every=1000, checkpoint_every=500,
+)
+# lip_ad_nyu. LIP+AD from the exported lip_cnn_nyu model: D pretrained 500 steps with G frozen, then 2000 joint
+# steps (protocol and sampler as lip_cnn_nyu). Budget 40k images, ~2 min at GPU_IMAGES_PER_S (estimate, plus the
+# discriminator's cost). Needs `--export runs/lip_cnn_nyu/model` on the lip_cnn_nyu run first (or --set init_from=).
+LIP_AD_NYU = dataclasses.replace(
+    LIP_AD_INDOOR, name="lip-ad-nyu", data=NYU_PAPER_DATA, batch_size=16, init_from="runs/lip_cnn_nyu/model",
+    d_steps=500, adv_steps=2000, eval_every=500, checkpoint_every=250,
+)
+# lip_cnn_kitti. Protocol kitti_paper: KITTI depth completion train/val, bottom crop 256x1216; depth 0-80 m. Sampler:
+# the real projected Velodyne scan (velodyne_raw, sampler "input"), not points drawn from the ground truth, which is
+# the semi-dense annotated depth. Model: the outdoor LIP (log-depth prox, nearest fill). Budget: 30000 steps x
+# batch 8 = 240k images (~2.8 epochs of 86k frames). Expected runtime on one GPU: ~38 min at GPU_IMAGES_PER_S
+# scaled by pixels (256x1216 is 3.8x 256x320; estimate).
+LIP_CNN_KITTI = dataclasses.replace(
+    LIP_CNN_OUTDOOR, name="lip-cnn-kitti", data=KITTI_PAPER_DATA, batch_size=8, g_steps=30000, warmup_steps=500,
+    eval_every=1000, checkpoint_every=500,
+)
+# lip_ad_kitti. LIP+AD from the exported lip_cnn_kitti model (500 D + 2000 joint steps, batch 8, as lip_cnn_kitti's
+# data). Budget 20k images, ~3 min at GPU_IMAGES_PER_S scaled by pixels (estimate). Needs lip_cnn_kitti exported to
+# runs/lip_cnn_kitti/model (or --set init_from=).
+LIP_AD_KITTI = dataclasses.replace(
+    LIP_AD_OUTDOOR, name="lip-ad-kitti", data=KITTI_PAPER_DATA, batch_size=8, init_from="runs/lip_cnn_kitti/model",
+    d_steps=500, adv_steps=2000, eval_every=500, checkpoint_every=250,
+)
+# lip_cnn_tartanair. Protocol tartanair: left-camera frames, centre crop 480x600, resize 256x320, depth 0-80 m;
+# split 90/5/5 by trajectory. Sampler: 200 uniform points. Model: the outdoor LIP (log-depth prox: TartanAir spans
+# indoor and outdoor depths). Budget: 20000 steps x batch 16 = 320k images. Expected runtime on one GPU: ~13 min at
+# GPU_IMAGES_PER_S (estimate).
+LIP_CNN_TARTANAIR = dataclasses.replace(
+    LIP_CNN_OUTDOOR, name="lip-cnn-tartanair", data=TARTANAIR_DATA, batch_size=16, g_steps=20000, warmup_steps=500,
+    eval_every=1000, checkpoint_every=500,
+)
+# lip_cnn_folder. Your own RGB-D frames (lipjax.data.folder layout: rgb/, depth/, intrinsics; train/ and val/
+# subfolders, else the last 5 % of the frames validate), fine-tuned from the shipped lip-cnn-indoor. Protocol: none
+# (frames as they are, random 128x160 crops; --set data.crop=H,W). Sampler: a mixture of 200 / 500 uniform and
+# 200 Bernoulli points; "input" uses your own sparse/<stem> maps. PNG depth needs --set data.depth_scale=1000 (or
+# 256, 5000). Budget: 2000 steps x batch 8 = 16k images: ~15 min on a 2-core CPU at this repository's measured
+# ~20 images/s, well under a minute on one GPU (estimate). Also `lipjax train --config lip_cnn_folder --set ...`.
+LIP_CNN_FOLDER = dataclasses.replace(
+    LIP_CNN_INDOOR, name="lip-cnn-folder", data=FOLDER_DATA, init_from="lip-cnn-indoor", g_steps=2000,
+    learning_rate=2e-4, warmup_steps=100, eval_every=500, checkpoint_every=250,
+)
+# The end-to-end baselines on the same data (Ma et al., U-Net, CSPN; the preset of the synthetic baselines above):
+# each takes its LIP+CNN run's data, protocol, sampler, batch size, loss and step budget, so its runtime is about
+# that run's (the networks have about LIP small's parameter count).
+REAL_DATA_BASELINES: dict[str, TrainConfig] = {
+    f"{key}_{scene}": _baseline(lip, f"{key}-{scene}", model_type, depth)
+    for key, model_type in (("ma2018", "sparse_to_dense"), ("unet", "unet"), ("cspn", "cspn"))
+    for scene, lip, depth in (("nyu", LIP_CNN_NYU, INDOOR_MAX_DEPTH_M), ("kitti", LIP_CNN_KITTI, OUTDOOR_MAX_DEPTH_M),
+                              ("tartanair", LIP_CNN_TARTANAIR, OUTDOOR_MAX_DEPTH_M))
+}
+
 SMOKE = TrainConfig(
     name="smoke", model=LIPConfig(prior=network_preset("tiny"), num_iterations=2),
     data=DataConfig(kind="indoor", height=48, width=64, crop=(32, 48), val_images=4),
@@ -142,6 +223,13 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_fast_indoor": LIP_FAST_INDOOR,
     "smoke": SMOKE,
     **BASELINE_CONFIGS,
+    "lip_cnn_nyu": LIP_CNN_NYU,
+    "lip_ad_nyu": LIP_AD_NYU,
+    "lip_cnn_kitti": LIP_CNN_KITTI,
+    "lip_ad_kitti": LIP_AD_KITTI,
+    "lip_cnn_tartanair": LIP_CNN_TARTANAIR,
+    "lip_cnn_folder": LIP_CNN_FOLDER,
+    **REAL_DATA_BASELINES,
 }
 
 

@@ -184,3 +184,17 @@ def test_config_overrides_reach_nested_fields_convert_types_and_reject_unknown_n
     assert get_config("smoke", {"model.learn_rho": "false"}).model.learn_rho is False
     with pytest.raises(ValueError, match="true or false"):
         get_config("smoke", {"model.learn_rho": "no"})
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--config", "nope"], "unknown config 'nope'"),
+    (["--config", "smoke", "--set", "g_step=3"], "unknown config field 'g_step'"),
+    (["--config", "smoke", "--set", "g_steps"], "expected FIELD=VALUE"),
+])
+def test_train_command_errors_are_one_line(args, message, capsys):
+    from experiments import train as train_command
+
+    with pytest.raises(SystemExit) as exit_:
+        train_command.main(args)
+    err = capsys.readouterr().err.strip()
+    assert exit_.value.code == 2 and message in err and len(err.splitlines()) == 1

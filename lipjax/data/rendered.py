@@ -124,7 +124,7 @@ def _render_shard(spec: RenderSpec, shard: int, out: str) -> int:
         frame_rgb, frame_depth = _render_frame(spec, index)
         raw = np.rint(frame_depth.astype(np.float64) * scale)
         if raw.max() > np.iinfo(np.uint16).max:
-            raise ValueError(f"frame {index}: depth {frame_depth.max():.1f} m exceeds the uint16 range at scale {scale}")
+            raise ValueError(f"frame {index}: depth {frame_depth.max():.1f} m exceeds uint16 at scale {scale} per metre")
         rgb[row], depth[row] = frame_rgb, raw.astype(np.uint16)
     arrays = {"rgb": rgb, "depth": depth}
     if spec.window:
@@ -263,4 +263,5 @@ class RenderedDataset:
         return {**self.__dict__, "_shards": {}}
 
     def __repr__(self) -> str:
-        return f"RenderedDataset({os.fspath(self.root)!r}: {self.kind}/{self.split}, {self.count} frames {self.frame_size})"
+        where = os.fspath(self.root)
+        return f"RenderedDataset({where!r}: {self.kind}/{self.split}, {self.count} frames {self.frame_size})"

@@ -36,6 +36,7 @@ DEFAULT_PROTOCOLS = {"nyu_h5": "nyu_paper", "nyu_tfds": "nyu_paper", "kitti_dc":
                      "kitti_odometry": "kitti_paper", "tartanair": "tartanair"}
 VAL_TAIL_FRACTION = 0.05  # sources without a val split hold out the last 5 % of each sequence / folder
 OWN_INPUT = "input"
+NO_PROTOCOL = "none"  # data.protocol="none": frames as they are, even where the source has a default
 
 
 @dataclasses.dataclass(frozen=True)
@@ -179,7 +180,7 @@ def open_source(data: Any, split: str) -> Source:
         raise ValueError(f"split must be 'train' or 'val', got {split!r}")
     dataset, own = _raw_dataset(data, split)
     protocol_name = data.protocol or DEFAULT_PROTOCOLS.get(data.source)
-    protocol = get_protocol(protocol_name) if protocol_name else None
+    protocol = get_protocol(protocol_name) if protocol_name not in (None, NO_PROTOCOL) else None
     spec = data.train_sampler if split == "train" else data.val_sampler
     if spec.split(":")[0].strip() == OWN_INPUT:
         if own is None:

@@ -15,7 +15,7 @@ import jax.numpy as jnp
 import optax
 
 from lipjax.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
-from lipjax.train.config import TrainConfig
+from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import TrainState, make_optimizers
 
 StepFn = Callable[[TrainState, dict, jax.Array], tuple[TrainState, dict]]
@@ -32,9 +32,15 @@ def _rgb01(rgb):
     return rgb.astype(jnp.float32) / 255.0
 
 
-@functools.lru_cache(maxsize=None)
 def make_steps(config: TrainConfig) -> Steps:
-    """The three jitted steps of a config; cached so that runs with the same config share compilations."""
+    """The three jitted steps of a config; runs whose configs differ only in what the steps do not read (name,
+    data, logging, checkpointing, initialisation) share them and their compilations."""
+    return _make_steps(dataclasses.replace(config, name="", data=DataConfig(), log_every=1, eval_every=0,
+                                           checkpoint_every=1, keep_checkpoints=1, init_from=None))
+
+
+@functools.lru_cache(maxsize=None)
+def _make_steps(config: TrainConfig) -> Steps:
     g_opt, d_opt = make_optimizers(config)
     model_config = config.model
     scale = model_config.max_depth_m

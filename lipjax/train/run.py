@@ -1,0 +1,71 @@
+"""A whole training run as one call: train (or resume) in a workdir, validate, plot, export only where asked.
+
+    run(config, "runs/lip_cnn_nyu", export="runs/lip_cnn_nyu/model")
+
+Used by `python -m experiments.train` and `lipjax train`. Nothing is written outside `workdir` and `export`.
+"""
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+
+from lipjax import model_io
+from lipjax.checkpoint import CheckpointManager
+from lipjax.train.config import TrainConfig
+from lipjax.train.curves import plot_curves
+from lipjax.train.loop import evaluate_params, export as export_model, train, validation_batches
+from lipjax.train.state import init_state
+
+
+def parse_overrides(items: list[str]) -> dict[str, str]:
+    """["a.b=1", ...] -> {"a.b": "1"}; one-line ValueError for an item without '=' or a field."""
+    overrides = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ValueError(f"--set {item!r}: expected FIELD=VALUE, e.g. --set g_steps=200")
+        overrides[key.strip()] = value
+    return overrides
+
+
+def logged_validation(metrics_path: pathlib.Path, step: int) -> dict | None:
+    """The validation metrics the training loop logged at `step`, if any."""
+    if not metrics_path.exists():
+        return None
+    rows = [json.loads(line) for line in metrics_path.read_text().splitlines() if line.strip()]
+    found = [r for r in rows if r.get("split") == "val" and r["step"] == step]
+    return {k: v for k, v in found[-1].items() if k not in ("split", "step")} if found else None
+
+
+def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
+        export_only: bool = False, progress: bool = True) -> dict:
+    """Trains `config` in `workdir` (resuming), then validates and, when `export` is a path, saves the model there.
+
+    export_only: skip training and export the latest checkpoint. Returns the validation metrics (metres).
+    """
+    workdir = pathlib.Path(workdir)
+    if export_only:
+        manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
+        if manager.latest_step() is None:
+            raise FileNotFoundError(f"no checkpoint in {manager.directory} to export; train first (drop --export-only)")
+        init = model_io.load(config.init_from)[1] if config.init_from else None
+        state, _ = manager.restore(init_state(config, init))
+        manager.close()
+    else:
+        state = train(config, workdir, progress=progress)
+    val = logged_validation(workdir / "metrics.jsonl", int(state.step))
+    if val is None:  # not evaluated at this step by the loop (e.g. --export-only of an older checkpoint)
+        val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
+    if (workdir / "metrics.jsonl").exists():
+        plot_curves(workdir / "metrics.jsonl", workdir / "curves.png", title=config.name)
+    if export is not None:
+        d = config.data
+        export_model(config, state, export, {"val_metrics": val, "val_sampler": d.val_sampler,
+                                             "val_images": d.val_images, "data": d.kind if d.source == "synthetic"
+                                             else d.source})
+        print(f"[lipjax] exported {config.name} (step {int(state.step)}) to {export}: val rmse_m={val['rmse_m']:.4f}")
+    else:
+        print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f} "
+              "(nothing exported; add --export PATH)")
+    return val

@@ -1,0 +1,198 @@
+"""Every training source from tiny fixture files in its real on-disk format: open, train a few steps, resume.
+
+Formats written here: NYU h5 (Ma et al.), KITTI depth completion (annotated + velodyne_raw + raw drive + calib),
+a user folder (rgb/ depth/ sparse/ intrinsics.txt) and `lipjax data render` shards. The network is the tiny
+preset with one iteration and every test uses the same crop, so the train step compiles once for the file.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+
+import cv2
+import h5py
+import jax
+import numpy as np
+import pytest
+
+from lipjax.checkpoint import CheckpointManager
+from lipjax.data.rendered import RenderedDataset, render_to_disk
+from lipjax.data.sources import open_source
+from lipjax.data.synthetic import render
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+from lipjax.train import loop
+from lipjax.train.config import DataConfig, TrainConfig
+from lipjax.train.state import init_state
+
+H, W = 30, 40  # fixture frames; training crops are CROP
+CROP = (24, 32)
+DRIVE = "2011_09_26_drive_0002_sync"
+CALIB = ("P_rect_02: 7.2e+02 0 6.0e+02 4.4e+01 0 7.2e+02 1.7e+02 0.2 0 0 1 0.003\n"
+         "P_rect_03: 7.2e+02 0 6.0e+02 -3.3e+02 0 7.2e+02 1.7e+02 2.2 0 0 1 0.003\n")
+
+
+def frame(seed: int, max_depth_m: float = 9.0) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    rgb = rng.integers(0, 256, (H, W, 3), dtype=np.uint8)
+    depth = rng.uniform(0.5, max_depth_m, (H, W)).astype(np.float32)
+    depth[rng.random((H, W)) < 0.1] = 0
+    return rgb, depth
+
+
+def write_rgb(path, rgb):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    assert cv2.imwrite(str(path), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR))
+
+
+def write_png16(path, metres, scale):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    assert cv2.imwrite(str(path), np.rint(metres * scale).astype(np.uint16))
+
+
+def make_nyu(root, n=4):
+    for split in ("train", "val"):
+        for i in range(n):
+            rgb, depth = frame(i + (100 if split == "val" else 0))
+            path = root / "nyudepthv2" / split / "office_0001" / f"{i + 1}.h5"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with h5py.File(path, "w") as f:
+                f["rgb"] = np.transpose(rgb, (2, 0, 1))  # (3, H, W) as in Ma et al.'s files
+                f["depth"] = depth
+    return root
+
+
+def make_kitti(root, n=4):
+    (root / "raw" / DRIVE[:10]).mkdir(parents=True)
+    (root / "raw" / DRIVE[:10] / "calib_cam_to_cam.txt").write_text(CALIB)
+    for split in ("train", "val"):
+        for i in range(n):
+            rgb, gt = frame(i + (100 if split == "val" else 0), 80.0)
+            velo = np.where(np.random.default_rng(i).random((H, W)) < 0.1, gt, 0)
+            name = f"{i:010d}.png"
+            base = root / "depth"
+            write_png16(base / "data_depth_annotated" / split / DRIVE / "proj_depth/groundtruth/image_02" / name, gt, 256)
+            write_png16(base / "data_depth_velodyne" / split / DRIVE / "proj_depth/velodyne_raw/image_02" / name, velo, 256)
+            write_rgb(root / "raw" / DRIVE[:10] / DRIVE / "image_02/data" / name, rgb)
+    return root
+
+
+def make_folder(root, n=6):
+    for i in range(n):
+        rgb, depth = frame(200 + i)
+        write_rgb(root / "rgb" / f"{i:04d}.png", rgb)
+        write_png16(root / "depth" / f"{i:04d}.png", depth, 1000)
+        write_png16(root / "sparse" / f"{i:04d}.png", np.where(np.arange(H * W).reshape(H, W) % 17 == 0, depth, 0), 1000)
+    (root / "intrinsics.txt").write_text("40 40 20 15\n")
+    return root
+
+
+CONFIG = TrainConfig(
+    name="sources", model=LIPConfig(prior=network_preset("tiny"), num_iterations=1),
+    data=DataConfig(crop=CROP, train_sampler="uniform:30", val_sampler="uniform:30", val_images=2, num_workers=0),
+    batch_size=2, g_steps=3, log_every=1, eval_every=3, checkpoint_every=1,
+)
+
+
+def source_config(tmp_path, source: str) -> DataConfig:
+    """The DataConfig of `source` over fixture files written under tmp_path."""
+    d = CONFIG.data
+    if source == "nyu_h5":
+        return dataclasses.replace(d, source=source, root=str(make_nyu(tmp_path / "nyu")), protocol="none")
+    if source == "kitti_dc":
+        root = make_kitti(tmp_path / "kitti")
+        return dataclasses.replace(d, source=source, root=str(root / "depth"), raw_root=str(root / "raw"),
+                                   protocol="none", train_sampler="input", val_sampler="input:20")
+    if source == "folder":
+        return dataclasses.replace(d, source=source, root=str(make_folder(tmp_path / "folder")), depth_scale=1000.0,
+                                   train_sampler="input")
+    if source == "rendered":
+        out = render_to_disk("indoor", "train", 6, tmp_path / "rendered", height=H, width=W, workers=1, progress=False)
+        return dataclasses.replace(d, source=source, root=str(out), height=H, width=W)
+    raise AssertionError(source)
+
+
+def test_kitti_input_is_the_real_scan_and_folder_input_its_sparse_maps(tmp_path):
+    kitti_config = source_config(tmp_path, "kitti_dc")
+    kitti = open_source(kitti_config, "train")
+    sample = kitti.dataset[1]
+    scan = cv2.imread(str(tmp_path / f"kitti/depth/data_depth_velodyne/train/{DRIVE}/proj_depth/velodyne_raw/"
+                                     "image_02/0000000001.png"), cv2.IMREAD_UNCHANGED) / np.float32(256)
+    assert np.array_equal(kitti.sampler(sample), scan.astype(np.float32))
+    val = open_source(kitti_config, "val")
+    assert np.count_nonzero(val.sampler(val.dataset[0])) == 20
+    folder = source_config(tmp_path, "folder")
+    train, val = open_source(folder, "train"), open_source(folder, "val")
+    assert (len(train.dataset), len(val.dataset)) == (5, 1)  # no train/ val/: the last 5 % (>= 1 frame) validates
+    own = cv2.imread(str(tmp_path / "folder/sparse/0000.png"), cv2.IMREAD_UNCHANGED) / np.float32(1000)
+    assert np.array_equal(train.sampler(train.dataset[0]), own.astype(np.float32)) and own.any()
+    with pytest.raises(ValueError, match="no sparse input of its own"):
+        open_source(dataclasses.replace(CONFIG.data, train_sampler="input"), "train")
+    with pytest.raises(ValueError, match="needs data.root"):
+        open_source(dataclasses.replace(CONFIG.data, source="nyu_h5"), "train")
+
+
+def test_rendered_shards_hold_the_on_the_fly_frames(tmp_path):
+    out = render_to_disk("indoor", "train", 5, tmp_path / "r", height=H, width=W, workers=2, shard_size=2,
+                         progress=False)
+    index = json.loads((out / "index.json").read_text())
+    assert index["count"] == 5 and index["shards"] == ["shard-00000", "shard-00001", "shard-00002"]
+    assert index["depth_dtype"] == "uint16" and index["depth_scale"] == 1000.0
+    data = RenderedDataset(out)
+    for i in (0, 3, 4):
+        want, got = render("indoor", "train", i, H, W), data[i]
+        assert got.id == want.id and got.intrinsics == want.intrinsics and np.array_equal(got.rgb, want.rgb)
+        assert np.abs(got.depth - want.depth).max() <= 0.5e-3 + 1e-6 and np.array_equal(got.valid, want.valid)
+    with pytest.raises(ValueError, match="different render"):
+        render_to_disk("indoor", "train", 6, out, height=H, width=W, workers=1, progress=False)
+    window = RenderedDataset(render_to_disk("outdoor", "val", 2, tmp_path / "w", height=H, width=W, window=(16, 24),
+                                            workers=1, progress=False))
+    full = render("outdoor", "val", 1, H, W).intrinsics
+    top, left = full.cy - window[1].intrinsics.cy, full.cx - window[1].intrinsics.cx
+    assert window[1].shape == (16, 24) and 0 <= top <= H - 16 and 0 <= left <= W - 24
+
+
+@pytest.mark.parametrize("source", ["nyu_h5", "kitti_dc", "folder", "rendered"])
+def test_trains_a_few_steps_and_resumes(tmp_path, source):
+    config = dataclasses.replace(CONFIG, name=source, data=source_config(tmp_path, source))
+    loop.train(config, tmp_path / "run", stop_at=2, progress=False)  # the "killed" run
+    state = loop.train(config, tmp_path / "run", progress=False)
+    assert int(state.step) == 3
+    rows = [json.loads(line) for line in (tmp_path / "run" / "metrics.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in rows if "phase" in r] == [1, 2, 3] and all(np.isfinite(r["loss"]) for r in rows if "loss" in r)
+    assert [r for r in rows if r.get("split") == "val"][0]["rmse_m"] > 0
+    _, meta = CheckpointManager(tmp_path / "run" / "checkpoints").restore(init_state(config))
+    assert meta["data_loader"]["next_step"] == 3
+
+
+def test_workers_resume_bit_identically(tmp_path):
+    """A run with 2 loader processes, killed and resumed from the grain state, equals one straight run."""
+    config = dataclasses.replace(CONFIG, data=dataclasses.replace(source_config(tmp_path, "rendered"), num_workers=2),
+                                 eval_every=0)
+    straight = loop.train(config, tmp_path / "straight", progress=False)
+    loop.train(config, tmp_path / "killed", stop_at=1, progress=False)
+    resumed = loop.train(config, tmp_path / "killed", progress=False)
+    for a, b in zip(jax.tree_util.tree_leaves(straight.g_params), jax.tree_util.tree_leaves(resumed.g_params)):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+
+
+def test_lip_cnn_folder_trains_exports_and_the_model_completes(tmp_path):
+    """The issue's "done when": the named config on a folder, exported to a given path, then `lipjax complete`."""
+    root = make_folder(tmp_path / "folder")
+    model = tmp_path / "model"
+    args = ["--config", "lip_cnn_folder", "--workdir", str(tmp_path / "run"), "--no-progress", "--export", str(model),
+            "--set", f"data.root={root}", "--set", "data.depth_scale=1000", "--set", "data.crop=24,32",
+            "--set", "data.num_workers=0", "--set", "g_steps=2", "--set", "batch_size=2", "--set", "eval_every=0"]
+    train = subprocess.run([sys.executable, "-m", "experiments.train", *args], capture_output=True, text=True,
+                           timeout=600)
+    assert train.returncode == 0, train.stderr[-3000:]
+    assert model.with_suffix(".json").is_file()
+    out = tmp_path / "out.npy"
+    done = subprocess.run([sys.executable, "-m", "lipjax.cli", "complete", "--model", str(model), "--rgb",
+                           str(root / "rgb" / "0000.png"), "--depth", str(root / "sparse" / "0000.png"),
+                           "--depth-scale", "1000", "--out", str(out), "--quiet"], capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert np.load(out).shape == (H, W)
