@@ -20,11 +20,11 @@ import jax
 import numpy as np
 
 from lipjax import model_io
-from lipjax.inputs import InputError, check_inputs  # noqa: F401  (re-exported: lipjax.InputError)
+from lipjax.inputs import DEFAULT_MODELS, InputError, check_inputs, suggest_scene  # noqa: F401  (lipjax.InputError)
 from lipjax.model import LIPConfig, host_inputs_of
 from lipjax.zbuffer import splat_nearest
 
-DEFAULT_MODEL = "lip-ad-indoor"
+DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
 
 
 @functools.lru_cache(maxsize=None)
@@ -72,14 +72,14 @@ class Completer:
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
-        rgb, sparse, batched = check_inputs(rgb, sparse)
+        rgb, sparse, batched = check_inputs(rgb, sparse, getattr(self.config, "max_depth_m", None), self.name)
         depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
-        rgb, sparse, _ = check_inputs(rgb, sparse)
+        rgb, sparse, _ = check_inputs(rgb, sparse, getattr(self.config, "max_depth_m", None), self.name)
         return compiled_apply(self.config, True)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
 
     def parameter_count(self) -> int:
@@ -92,22 +92,25 @@ def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:
     return Completer(config, params, name=str(name_or_path), metadata=metadata)
 
 
-@functools.lru_cache(maxsize=1)
-def default_model() -> Completer:
-    """The shipped DEFAULT_MODEL (loaded once), or, while no weights are shipped, an untrained model (warns)."""
-    if DEFAULT_MODEL in model_io.available():
-        return load_model(DEFAULT_MODEL)
-    warnings.warn(f"no trained weights shipped ({DEFAULT_MODEL!r} is not in `lipjax models`): using an UNTRAINED "
+@functools.lru_cache(maxsize=2)
+def default_model(scene: str = "indoor") -> Completer:
+    """The shipped default model of `scene` (DEFAULT_MODELS; loaded once), or, while no weights are shipped, an
+    untrained model (warns)."""
+    name = DEFAULT_MODELS[scene]
+    if name in model_io.available():
+        return load_model(name)
+    warnings.warn(f"no trained weights shipped ({name!r} is not in `lipjax models`): using an UNTRAINED "
                   "model, whose output is only a smooth fill of the samples; pass a model name or path", stacklevel=2)
     return Completer.random()
 
 
-def get_completer(model: Any = None, iterations: int | None = None):
+def get_completer(model: Any = None, iterations: int | None = None, sparse: np.ndarray | None = None):
     """A completer: `model` is a completer object, any `lipjax.methods` name (shipped model, saved model path,
-    lip-wavelet, nearest, linear, ip_basic, colorization) or None (`default_model()`). With `iterations`, a LIP
-    model runs only its first K iterations."""
+    lip-wavelet, nearest, linear, ip_basic, colorization) or None: `default_model`, outdoor when the `sparse`
+    depth given (metres) looks outdoor (`lipjax.inputs.suggest_scene`). With `iterations`, a LIP model runs only
+    its first K iterations."""
     if model is None:
-        completer = default_model()
+        completer = default_model("indoor" if sparse is None else suggest_scene(sparse))
     elif isinstance(model, (str, os.PathLike)):
         from lipjax.methods import get_method  # lipjax.methods imports this module
 
@@ -125,9 +128,10 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None) -> np.ndarr
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
     `model`: a completer, a shipped model name, a saved model path or any `lipjax.methods` name ("linear",
-    "ip_basic", ...); by default the shipped DEFAULT_MODEL (see `default_model`).
+    "ip_basic", ...); by default the shipped default model, indoor or outdoor as the samples suggest
+    (`get_completer`).
     """
-    return get_completer(model)(rgb, sparse)
+    return get_completer(model, sparse=sparse)(rgb, sparse)
 
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.

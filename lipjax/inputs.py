@@ -3,27 +3,59 @@ and one set of messages, each naming the problem.
 
     rgb, sparse, batched = check_inputs(rgb, sparse)    # (H, W, 3) or (B, H, W, 3); uint8 or float in [0, 1]
     rgb, sparse = check_frame(rgb, sparse)              # exactly one (H, W, 3) uint8 frame (classical methods)
+    check_for_model(sparse, max_depth_m=10.0, name="lip-ad-indoor")   # units, range and pattern vs the model
+    scene = suggest_scene(sparse)                       # "indoor" | "outdoor": which default model fits the input
 
-Sparse depth is float metres with 0 = no sample.
+Sparse depth is float metres with 0 = no sample. A unit mistake that is near certain raises InputError; one that is
+only probable, or data unlike what the model was trained on, gives a one-line `warnings.warn` naming the likely
+cause (the same text for every frame, so a folder of frames warns once):
+
+    median sample depth > 1000 m                          error: not metres (millimetres?)
+    median > 10x the model's range (10 m / 85 m)          error: centimetres or millimetres for this model
+    indoor model, a quarter of the samples beyond 10 m    warning: outdoor data (scan lines, or samples beyond
+                                                          39 m): use the outdoor model; else a millimetre (Kinect)
+                                                          PNG read with --depth-scale 256, or outdoor data
+    indoor model, samples in LiDAR scan lines             warning: trained on scattered points, not scan lines
+    outdoor model, median beyond 85 m or max beyond 340 m warning: centimetres given as metres?
+    outdoor model, all within 10 m, no scan lines         warning: looks like indoor data
+    outdoor model, a dense map within 39 m                warning: a millimetre PNG read with --depth-scale 256?
+    samples 4x sparser than the sparsest training input   warning: expect larger errors
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-# A sparse map reaching this is not in metres (no depth sensor here measures a kilometre); likely millimetres.
+# A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
+# The deepest indoor samples (Kinect, NYU v2); also the range of the indoor models (config.max_depth_m, 85 m outdoor).
+INDOOR_DEPTH_M = 10.0
+# Input whose median sample depth exceeds this is outdoor data (no room is that deep).
+OUTDOOR_MEDIAN_M = 12.0
+# The default shipped model per scene (lipjax.inference.DEFAULT_MODEL is the indoor one).
+DEFAULT_MODELS = {"indoor": "lip-ad-indoor", "outdoor": "lip-ad-outdoor"}
+# Sparsest training input of the shipped models, samples per pixel (experiments/configs.py: indoor uniform:100 on
+# 256x320, outdoor uniform:200 on 128x416); a warning below a quarter of it.
+TRAINED_MIN_DENSITY = {"indoor": 100 / (256 * 320), "outdoor": 200 / (128 * 416)}
+# Indoor depth (<= 10 m) stored in millimetres but read with --depth-scale 256 reaches at most this.
+KINECT_AT_256_M = INDOOR_DEPTH_M * 1000 / 256
+# Samples per pixel above which a map is a depth camera's or stereo's, not LiDAR's (KITTI's raw scans: ~5 %).
+DENSE = 0.3
 
 
 class InputError(ValueError):
     """Bad input to a completer: the message names the problem."""
 
 
-def check_inputs(rgb, sparse) -> tuple[np.ndarray, np.ndarray, bool]:
+def check_inputs(rgb, sparse, max_depth_m: float | None = None,
+                 name: str = "this model") -> tuple[np.ndarray, np.ndarray, bool]:
     """Validates and batches inputs. Returns (rgb (B,H,W,3) uint8|float32, sparse (B,H,W) float32, was_batched).
 
     Raises InputError for: a wrong rank or channel count, an rgb dtype other than uint8 / float in [0, 1],
     mismatching sizes, non-float sparse depth (a raw PNG), NaN / inf or negative depth, an image without any
-    sample, and depth that is clearly not metres.
+    sample, and depth that is clearly not metres. With `max_depth_m`, the range (metres) of the model `name`,
+    also `check_for_model`.
     """
     rgb = np.asarray(rgb)
     sparse = np.asarray(sparse)
@@ -49,9 +81,12 @@ def check_inputs(rgb, sparse) -> tuple[np.ndarray, np.ndarray, bool]:
         rgb, sparse = rgb[None], sparse[None]
     empty = [i for i in range(sparse.shape[0]) if not (sparse[i] > 0).any()]
     if empty:
-        raise InputError(f"sparse depth is empty: no samples (all zeros) in image(s) {empty}; nothing to complete from")
-    if sparse.max() > MAX_PLAUSIBLE_DEPTH_M:
-        raise InputError(f"sparse depth reaches {sparse.max():.0f}: that is not metres (millimetres? divide by 1000)")
+        raise InputError(f"sparse depth is empty: no samples (all zeros) in image(s) {empty}; nothing to complete")
+    median = float(np.median(sparse[sparse > 0]))
+    if median > MAX_PLAUSIBLE_DEPTH_M:
+        raise InputError(f"sparse depth has a median of {median:.0f}: not metres (millimetres? divide by 1000)")
+    if max_depth_m is not None:
+        check_for_model(sparse, max_depth_m, name)
     if np.issubdtype(rgb.dtype, np.floating):
         rgb = rgb.astype(np.float32)
     return rgb, sparse.astype(np.float32), batched
@@ -66,3 +101,78 @@ def check_frame(rgb, sparse) -> tuple[np.ndarray, np.ndarray]:
         raise InputError(f"rgb must be uint8 (0-255), got {rgb.dtype}")
     rgb, sparse, _ = check_inputs(rgb, sparse)
     return rgb[0], sparse[0]
+
+
+def is_lidar_pattern(sparse: np.ndarray) -> bool:
+    """Whether the samples of a (H, W) map lie in LiDAR scan lines: most samples have a neighbour in their row
+    at most 4 px away, and samples in a column are at least twice as far apart as in a row."""
+    rows, cols = np.nonzero(np.asarray(sparse) > 0)
+    in_row = np.diff(cols)[np.diff(rows) == 0]  # np.nonzero is row-major: consecutive samples of one row
+    order = np.lexsort((rows, cols))
+    in_col = np.diff(rows[order])[np.diff(cols[order]) == 0]
+    if rows.size == 0 or in_row.size < rows.size / 2:
+        return False
+    row_gap = float(np.median(in_row))
+    return row_gap <= 4 and (in_col.size == 0 or float(np.median(in_col)) >= 2 * row_gap)
+
+
+def suggest_scene(sparse: np.ndarray) -> str:
+    """"outdoor" when the (H, W) or (B, H, W) samples (metres) look outdoor (median over OUTDOOR_MEDIAN_M, or
+    LiDAR scan lines), else "indoor": which default model to use."""
+    sparse = np.asarray(sparse, np.float32)
+    samples = sparse[sparse > 0]
+    if sparse.ndim not in (2, 3) or samples.size == 0:
+        return "indoor"  # nothing to judge: the input checks will name the problem
+    if float(np.median(samples)) > OUTDOOR_MEDIAN_M:
+        return "outdoor"
+    return "outdoor" if any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:])) else "indoor"
+
+
+def _other_model(name: str, scene: str) -> str:
+    """The shipped model of `scene` named like `name` (lip-cnn-indoor -> lip-cnn-outdoor), else the default."""
+    other = {"indoor": "outdoor", "outdoor": "indoor"}[scene]
+    shipped_like = name.endswith(f"-{other}") and "/" not in name and "\\" not in name
+    return name[: -len(other)] + scene if shipped_like else DEFAULT_MODELS[scene]
+
+
+def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model") -> None:
+    """Compares checked (B, H, W) or (H, W) sparse depth (metres) with what a model of range `max_depth_m` was
+    trained on: raises InputError where a unit mistake is near certain, warns (one line) where it is probable or
+    the input is unlike the training data. See the module docstring for the rules."""
+    sparse = np.asarray(sparse)
+    samples = sparse[sparse > 0]
+    median = float(np.median(samples))
+    if median > 10 * max_depth_m:
+        raise InputError(f"sparse depth has a median of {median:.0f} m, over 10x the {max_depth_m:g} m range of "
+                         f"{name}: not metres (centimetres? divide by 100; millimetres? by 1000)")
+    indoor = max_depth_m <= INDOOR_DEPTH_M
+    lidar = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
+    density = samples.size / sparse.size
+    if indoor:
+        outdoor_model = _other_model(name, "outdoor")
+        if np.quantile(samples, 0.75) > max_depth_m and (lidar or samples.max() > KINECT_AT_256_M):
+            _warn(f"sparse depth beyond the {max_depth_m:g} m range of the indoor model {name}: looks like outdoor "
+                  f"data, use {outdoor_model}")
+        elif np.quantile(samples, 0.75) > max_depth_m:
+            _warn(f"sparse depth beyond the {max_depth_m:g} m range of the indoor model {name}: a millimetre PNG "
+                  f"(Kinect, NYU) read with --depth-scale 256 (use 1000), or outdoor data (use {outdoor_model})?")
+        elif lidar:
+            _warn(f"samples in LiDAR scan lines, but the indoor model {name} was trained on scattered points: "
+                  f"{outdoor_model} was trained on scan lines")
+    elif median > max_depth_m or samples.max() > 4 * max_depth_m:
+        _warn(f"sparse depth far beyond the {max_depth_m:g} m range of {name}: centimetres given as metres? "
+              "divide by 100")
+    elif not lidar and samples.max() <= INDOOR_DEPTH_M:
+        _warn(f"every sample within {INDOOR_DEPTH_M:g} m and no LiDAR scan lines: looks like indoor data, use "
+              f"{_other_model(name, 'indoor')}")
+    elif not lidar and density > DENSE and samples.max() <= KINECT_AT_256_M:
+        _warn(f"a dense depth map within {KINECT_AT_256_M:.0f} m: a millimetre PNG (Kinect, NYU) read with "
+              f"--depth-scale 256 (use 1000), or indoor data (use {_other_model(name, 'indoor')})?")
+    trained = TRAINED_MIN_DENSITY["indoor" if indoor else "outdoor"]
+    if density < trained / 4:
+        _warn(f"samples on under a quarter as many pixels as in the sparsest input {name} was trained on "
+              f"({100 * trained:.2g} % of the pixels): expect larger errors")
+
+
+def _warn(message: str) -> None:
+    warnings.warn(message, stacklevel=5)  # _warn, check_for_model, check_inputs, the completer, its caller
