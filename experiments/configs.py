@@ -14,7 +14,7 @@ import dataclasses
 
 from lipjax.baselines.networks import baseline_preset
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
-from lipjax.discriminator import Discriminator
+from lipjax.train.discriminator import Discriminator
 from lipjax.model import LIPConfig
 from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
 from lipjax.priors.network import network_preset
@@ -66,7 +66,7 @@ LIP_CNN_INDOOR = TrainConfig(
 # to -15 m against ~15 m truth): thin poles above the top LiDAR beam, in a region that is mostly sky and so
 # unsupervised. A handful of such pixels costs the depth loss nothing but ruins the inverse-depth metrics (val
 # iRMSE 4135 1/km against 13 for the nearest fill). What was tried, on the 32 val frames (RMSE m / iRMSE 1/km):
-#   + inverse-depth term (lipjax.losses.inverse_depth_loss, 1/m, floor 1 m; also penalises depth below the floor
+#   + inverse-depth term (lipjax.train.losses.inverse_depth_loss, 1/m, floor 1 m; also penalises depth below the floor
 #     where there is no ground truth): 2 such pixels left, made by the final dual step's extrapolation
 #     z_K - u_K = 2 z_K - x_K - u_{K-1}: 4.344 / 177 (runs/lip-cnn-outdoor-v4, shipped in session 3);
 #   + output read from the last prox (LIPConfig.output="z"): the prox itself then made 6: 4.346 / 397 (v5);
@@ -126,6 +126,23 @@ LIP_FAST_INDOOR = dataclasses.replace(
     LIP_CNN_INDOOR, name="lip-fast-indoor", model=_fast_model(INDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE),
     data=dataclasses.replace(INDOOR_DATA, augment=DEFAULT_AUGMENT),
     g_steps=8000, learning_rate=1e-3, warmup_steps=200, eval_every=500, checkpoint_every=100,
+)
+# The outdoor counterpart: nearest fill (as lip-cnn-outdoor), the inverse-depth term, 128x208 crops of 128x416
+# renders (zoom >= 1 only: the renders are no taller than the crop, see lipjax.data.augment).
+LIP_FAST_OUTDOOR = dataclasses.replace(
+    LIP_FAST_INDOOR, name="lip-fast-outdoor", model=_fast_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE),
+    data=dataclasses.replace(OUTDOOR_DATA, augment=DEFAULT_AUGMENT),
+    inverse_depth_weight=LIP_CNN_OUTDOOR.inverse_depth_weight,
+    inverse_depth_floor_m=LIP_CNN_OUTDOOR.inverse_depth_floor_m,
+)
+# LIP+AD on the fast prox: D sees differences of log depth (Discriminator(inputs="log_gradients")): with depth /
+# max_depth, the paper's D stayed at chance (held-out accuracy 0.49-0.50 after 100 steps at lr 2e-4 or 1e-3, and
+# 4x wider); with log-depth differences it reached 0.76-0.89 (benchmarks/discriminator_probe.py --steps 100
+# --train 16 --val 8, G = lip-ad-indoor). Start from an exported lip-fast-indoor: --set init_from=PATH.
+LIP_AD_FAST_INDOOR = dataclasses.replace(
+    LIP_FAST_INDOOR, name="lip-ad-fast-indoor", init_from="lip-fast-indoor", g_steps=0, d_steps=100, adv_steps=600,
+    learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3,
+    discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M, inputs="log_gradients"),
 )
 
 # ---- The paper's data sets and your own (lipjax.data.sources). Each run reads its frames from --set data.root=DIR:
@@ -221,6 +238,8 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_ad_indoor": LIP_AD_INDOOR,
     "lip_ad_outdoor": LIP_AD_OUTDOOR,
     "lip_fast_indoor": LIP_FAST_INDOOR,
+    "lip_fast_outdoor": LIP_FAST_OUTDOOR,
+    "lip_ad_fast_indoor": LIP_AD_FAST_INDOOR,
     "smoke": SMOKE,
     **BASELINE_CONFIGS,
     "lip_cnn_nyu": LIP_CNN_NYU,
