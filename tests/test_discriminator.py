@@ -4,7 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from lipjax.discriminator import LOG_GRADIENT_GAIN, Discriminator, _log_gradients
+from lipjax.train.discriminator import LOG_GRADIENT_GAIN, Discriminator, _log_gradients
 
 
 def test_log_gradients_of_an_exponential_ramp_are_constant_and_masked():

@@ -6,8 +6,8 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from lipjax.discriminator import Discriminator
-from lipjax.losses import (
+from lipjax.train.discriminator import Discriminator
+from lipjax.train.losses import (
     depth_loss,
     discriminator_loss,
     generator_adversarial_loss,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 
 from lipjax.data.augment import Augment
-from lipjax.discriminator import Discriminator
+from lipjax.train.discriminator import Discriminator
 from lipjax.model import LIPConfig
 
 
@@ -64,7 +64,7 @@ class TrainConfig:
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
     loss: str = "l2"
-    inverse_depth_weight: float = 0.0  # weight of lipjax.losses.inverse_depth_loss (1/m) added to the depth loss
+    inverse_depth_weight: float = 0.0  # weight of lipjax.train.losses.inverse_depth_loss (1/m) added to the depth loss
     inverse_depth_floor_m: float = 1.0
     iteration_weights: tuple[float, ...] = ()
     adv_weight: float = 1e-3

@@ -14,7 +14,7 @@ import jax
 import jax.numpy as jnp
 import optax
 
-from lipjax.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
+from lipjax.train.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import TrainState, make_optimizers
 
