@@ -6,7 +6,7 @@ Run by hand (never a test):
 
 G is frozen (the model given); its outputs on `--train` synthetic indoor train crops and `--val` val crops
 (128x160, 200 uniform samples) are computed once. Each D variant then trains alone (Adam, batch 8, the
-cross-entropy of lipjax.losses.discriminator_loss) on the train crops, and its accuracy on the held-out val
+cross-entropy of lipjax.train.losses.discriminator_loss) on the train crops, and its accuracy on the held-out val
 crops, 0.5 * (P(real logit > 0) + P(fake logit < 0)), is printed every 100 steps: 0.5 is chance. This isolates
 D's ability from the adversarial game: a D that cannot beat chance here gives G no signal in LIP+AD.
 """
@@ -27,9 +27,9 @@ from lipjax.data.augment import Augment, augment_batch  # noqa: E402
 from lipjax.data.pipeline import BatchIterator  # noqa: E402
 from lipjax.data.sampling import sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.discriminator import Discriminator  # noqa: E402
+from lipjax.train.discriminator import Discriminator  # noqa: E402
 from lipjax.inference import compiled_apply, load_model  # noqa: E402
-from lipjax.losses import discriminator_loss  # noqa: E402
+from lipjax.train.losses import discriminator_loss  # noqa: E402
 from lipjax.model import host_inputs_of  # noqa: E402
 
 CROP = (128, 160)
