@@ -4,6 +4,7 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
+                    [--uncertainty FILE] [--max-uncertainty M]
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
     lipjax models
@@ -28,6 +29,11 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
             (rgb_00050.jpg <-> sync_depth_00050.png), as lipjax.data.folder.FolderDataset does.
   --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
             metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
+  --uncertainty  also write the expected absolute error of the completed depth (lipjax.uncertainty), metres:
+            X.npy float32 metres, or X.png a colour picture (dark blue 0 m to dark red >= --max-uncertainty, or
+            10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
+  --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
+            in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
 
 Image size: any. The model is fully convolutional and runs at the input resolution (the network pads to a
 multiple of 8 internally); a new size costs one compilation. `--max-side N` runs frames whose longer side
@@ -103,8 +109,12 @@ def _cmd_complete(args) -> int:
     from lipjax.data.folder import check_one_depth_format, output_format, pair_frames, read_frame, write_depth
     from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, get_completer
     from lipjax.pointcloud import backproject_rgbd, write_ply
+    from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
 
     rgb_path, depth_path, out, ply = Path(args.rgb), Path(args.depth), Path(args.out), args.ply and Path(args.ply)
+    unc = args.uncertainty and Path(args.uncertainty)
+    if args.max_uncertainty is not None and not args.max_uncertainty >= 0:
+        raise CLIError(f"--max-uncertainty {args.max_uncertainty:g}: must be >= 0 metres")
     intrinsics = _intrinsics_from_args(args)
     if ply and intrinsics is None:
         raise CLIError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
@@ -118,7 +128,7 @@ def _cmd_complete(args) -> int:
     if rgb_path.is_dir():
         pairs = [(r, d) for _, r, d in pair_frames(rgb_path, depth_path)]
         check_one_depth_format([d for _, d in pairs])
-        for flag, path in (("--out", out), ("--ply", ply)):
+        for flag, path in (("--out", out), ("--ply", ply), ("--uncertainty", unc)):
             if path and path.exists() and not path.is_dir():
                 raise CLIError(f"{flag} {path}: with input folders, {flag} must be a folder")
         fmt = args.out_format or ("png" if pairs[0][1].suffix.lower() == ".png" else "npy")
@@ -128,6 +138,8 @@ def _cmd_complete(args) -> int:
             raise CLIError("--out-format is for folders; for one frame the extension of --out chooses the format")
         fmt = output_format(out)
         jobs = [(rgb_path, depth_path, out, ply or None)]
+        if unc and unc.suffix.lower() not in (".npy", ".png"):
+            raise CLIError(f"--uncertainty {unc}: use .npy (metres) or .png (colour picture)")
     out_scale = args.depth_scale or DEFAULT_PNG_OUT_SCALE
 
     completer = None  # loaded after the first frame is read: input errors come before the slow model load
@@ -139,13 +151,20 @@ def _cmd_complete(args) -> int:
     for rgb_file, depth_file, out_file, ply_file in progress:
         rgb, sparse = read_frame(rgb_file, depth_file, args.depth_scale)
         if completer is None:
-            completer = get_completer(args.model, args.iterations)
+            completer = get_completer(args.model, args.iterations, sparse=sparse)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
             if args.max_side is None and sparse.size > LARGE_FRAME_PIXELS:
                 _warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) runs "
                       "slowly and needs gigabytes at full size; --max-side 1024 runs it downsized (--max-side 416 "
                       "with the shipped outdoor models, their training scale)")
         dense = complete_frame(completer, rgb, sparse, args.max_side)
+        if unc or args.max_uncertainty is not None:
+            u = expected_error(sparse, dense)
+            if unc:
+                write_uncertainty(unc / f"{rgb_file.stem}.npy" if rgb_path.is_dir() else unc, u,
+                                  args.max_uncertainty or 0.1 * _model_max_depth(completer))
+            if args.max_uncertainty is not None:
+                dense = drop_uncertain(dense, u, args.max_uncertainty)
         write_depth(out_file, dense, fmt, out_scale, color_range)
         if ply_file is not None:
             ply_file.parent.mkdir(parents=True, exist_ok=True)
@@ -297,6 +316,10 @@ def build_parser() -> argparse.ArgumentParser:
     intr = c.add_mutually_exclusive_group()
     intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"), help="pixels, of the RGB image")
     intr.add_argument("--intrinsics-file", default=None, metavar="F", help='"fx fy cx cy" or the 9 numbers of K')
+    c.add_argument("--uncertainty", default=None, metavar="FILE",
+                   help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
+    c.add_argument("--max-uncertainty", type=float, default=None, metavar="M",
+                   help="depth 0 (none) where the expected error is above M metres, in --out and --ply")
     c.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     c.set_defaults(func=_cmd_complete)
 

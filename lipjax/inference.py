@@ -124,14 +124,24 @@ def get_completer(model: Any = None, iterations: int | None = None, sparse: np.n
     return completer
 
 
-def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None) -> np.ndarray:
+def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_uncertainty: float | None = None,
+             return_uncertainty: bool = False):
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
     `model`: a completer, a shipped model name, a saved model path or any `lipjax.methods` name ("linear",
     "ip_basic", ...); by default the shipped default model, indoor or outdoor as the samples suggest
-    (`get_completer`).
+    (`get_completer`). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
+    (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
     """
-    return get_completer(model, sparse=sparse)(rgb, sparse)
+    dense = get_completer(model, sparse=sparse)(rgb, sparse)
+    if max_uncertainty is None and not return_uncertainty:
+        return dense
+    from lipjax.uncertainty import drop_uncertain, expected_error
+
+    u = expected_error(sparse, dense)
+    if max_uncertainty is not None:
+        dense = drop_uncertain(dense, u, max_uncertainty)
+    return (dense, u) if return_uncertainty else dense
 
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.

@@ -1,7 +1,8 @@
 """Per-pixel expected absolute error of a completed depth map, in metres, derived from where the samples are.
 
-    u = expected_error(sparse, depth)                  # (H, W) float32 metres, 0 on measured pixels
+    u = expected_error(sparse, depth)                  # (H, W) or (B, H, W) float32 metres, 0 on measured pixels
     depth = drop_uncertain(depth, u, max_uncertainty=2.0)  # 0 (no depth) where u > 2 m
+    write_uncertainty("u.npy", u, max_m=1.0)           # .npy metres, or .png: a colour picture, 0 .. max_m metres
 
 The estimate does not look at the method that made `depth`: the error of any completion grows with how far a
 pixel is from its samples and with the depth jumps among those samples. With, per pixel,
@@ -29,6 +30,9 @@ by least squares of |error| = gain * z above the samples. `python benchmarks/unc
 them; the same script reports the rank correlation with the actual error on the test splits and real frames.
 """
 from __future__ import annotations
+
+import os
+from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
@@ -71,14 +75,17 @@ def support_features(sparse: np.ndarray) -> dict[str, np.ndarray | float]:
 
 
 def expected_error(sparse: np.ndarray, depth: np.ndarray) -> np.ndarray:
-    """(H, W) float32 expected absolute error in metres of `depth`, a completion of `sparse` (both metres).
+    """(H, W) float32 expected absolute error in metres of `depth`, a completion of `sparse` (both metres); or
+    (B, H, W) for a batch.
 
     0 on measured pixels; highest (above every supported pixel) more than one sample spacing above the highest
     samples; see the module docstring for the formula and its calibration.
     """
     depth = np.maximum(np.asarray(depth, np.float32), 0.0)
     if depth.shape != np.shape(sparse):
-        raise ValueError(f"depth {depth.shape} and sparse depth {np.shape(sparse)} must have the same (H, W) shape")
+        raise ValueError(f"depth {depth.shape} and sparse depth {np.shape(sparse)} must have the same shape")
+    if depth.ndim == 3:
+        return np.stack([expected_error(s, d) for s, d in zip(sparse, depth)])
     f = support_features(sparse)
     r = f["distance"]
     u = SPREAD_GAIN * r * f["spread"]
@@ -97,3 +104,20 @@ def drop_uncertain(depth: np.ndarray, uncertainty: np.ndarray, max_uncertainty: 
     if np.shape(uncertainty) != depth.shape:
         raise ValueError(f"uncertainty {np.shape(uncertainty)} and depth {depth.shape} must have the same shape")
     return np.where(np.asarray(uncertainty) > max_uncertainty, 0.0, depth).astype(np.float32)
+
+
+def write_uncertainty(path: str | os.PathLike, uncertainty: np.ndarray, max_m: float) -> None:
+    """Writes (H, W) expected error (metres): X.npy as float32 metres; X.png as a colour picture (the error-map
+    colours of lipjax.viz: dark blue 0 m to dark red >= max_m metres)."""
+    from lipjax import viz
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    suffix = path.suffix.lower()
+    if suffix == ".npy":
+        np.save(path, np.asarray(uncertainty, np.float32))
+    elif suffix == ".png":
+        u = np.asarray(uncertainty, np.float32)
+        viz.write_png(path, viz.error_map(u, np.zeros_like(u), np.ones(u.shape, bool), max_error_m=max_m))
+    else:
+        raise ValueError(f"{path}: unknown uncertainty format {suffix!r}; use .npy (metres) or .png (picture)")

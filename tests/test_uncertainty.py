@@ -96,3 +96,83 @@ def test_ranks_the_linear_fill_error_on_a_synthetic_val_frame():
     scored = sample.valid & (sparse == 0)
     rho = spearmanr(expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored])[0]
     assert rho > 0.3
+
+
+# ------------------------------------------------ `lipjax complete --uncertainty FILE --max-uncertainty M`
+
+
+def _cli_frame(folder):
+    """A 36x48 frame on disk: scan lines from row 16 down (4 m left, 9 m right), nothing above; rgb png, npy."""
+    import cv2
+
+    sparse = np.zeros((36, 48), np.float32)
+    sparse[16::2, ::2] = np.where(np.arange(0, 48, 2) < 24, 4.0, 9.0)
+    rgb = np.random.default_rng(0).integers(0, 256, (36, 48, 3), dtype=np.uint8)
+    folder.mkdir(parents=True, exist_ok=True)
+    cv2.imwrite(str(folder / "f.png"), rgb[..., ::-1])
+    np.save(folder / "f.npy", sparse)
+    return rgb, sparse, ["--rgb", str(folder / "f.png"), "--depth", str(folder / "f.npy"), "--model", "linear"]
+
+
+def _cli(args):
+    from lipjax import cli
+
+    return cli.main(["complete", "--quiet"] + [str(a) for a in args])
+
+
+def test_cli_writes_the_expected_error_in_metres(tmp_path):
+    import lipjax
+
+    rgb, sparse, args = _cli_frame(tmp_path / "in")
+    assert _cli(args + ["--out", tmp_path / "d.npy", "--uncertainty", tmp_path / "u.npy"]) == 0
+    dense = lipjax.complete(rgb, sparse, model="linear")
+    u = np.load(tmp_path / "u.npy")
+    assert u.dtype == np.float32 and u.shape == sparse.shape
+    np.testing.assert_allclose(u, expected_error(sparse, dense), rtol=1e-6)
+    np.testing.assert_allclose(np.load(tmp_path / "d.npy"), dense, rtol=1e-6)  # no threshold: depth unchanged
+    assert u[:10].min() >= u[16:].max() and (u[sparse > 0] == 0).all()
+
+
+def test_cli_max_uncertainty_empties_depth_and_ply(tmp_path):
+    import lipjax
+
+    rgb, sparse, args = _cli_frame(tmp_path / "in")
+    dense, u = lipjax.complete(rgb, sparse, model="linear", return_uncertainty=True)
+    limit = float(u[16:].max())  # keeps every pixel at or below the top scan line
+    rc = _cli(args + ["--out", tmp_path / "d.npy", "--max-uncertainty", limit, "--ply", tmp_path / "c.ply",
+                      "--intrinsics", 40, 40, 23.5, 17.5, "--uncertainty", tmp_path / "u.png"])
+    assert rc == 0
+    out = np.load(tmp_path / "d.npy")
+    np.testing.assert_allclose(out, np.where(u > limit, 0.0, dense), rtol=1e-6)
+    assert (out[:10] == 0).all() and (out[16:] > 0).all()
+    header = (tmp_path / "c.ply").read_bytes().split(b"end_header\n")[0].decode()
+    assert f"element vertex {int((out > 0).sum())}" in header
+    import cv2
+
+    from lipjax import viz
+
+    picture = cv2.imread(str(tmp_path / "u.png"), cv2.IMREAD_UNCHANGED)[..., ::-1]
+    np.testing.assert_array_equal(picture, viz.error_map(u, np.zeros_like(u), np.ones(u.shape, bool), limit))
+    np.testing.assert_allclose(lipjax.complete(rgb, sparse, model="linear", max_uncertainty=limit), out, rtol=1e-6)
+
+
+def test_cli_uncertainty_folder_gets_one_npy_per_frame(tmp_path):
+    rgb, sparse, _ = _cli_frame(tmp_path / "rgb")
+    (tmp_path / "rgb" / "f.npy").rename(tmp_path / "f.npy")
+    (tmp_path / "depth").mkdir()
+    (tmp_path / "f.npy").rename(tmp_path / "depth" / "f.npy")
+    rc = _cli(["--rgb", tmp_path / "rgb", "--depth", tmp_path / "depth", "--model", "linear", "--out", tmp_path / "o",
+               "--uncertainty", tmp_path / "u"])
+    assert rc == 0
+    dense = np.load(tmp_path / "o" / "f.npy")
+    np.testing.assert_allclose(np.load(tmp_path / "u" / "f.npy"), expected_error(sparse, dense), rtol=1e-6)
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--uncertainty", "u.txt"], "lipjax: error: --uncertainty u.txt: use .npy (metres) or .png (colour picture)\n"),
+    (["--max-uncertainty", "-1"], "lipjax: error: --max-uncertainty -1: must be >= 0 metres\n"),
+])
+def test_cli_uncertainty_errors_are_one_line(tmp_path, capsys, extra, message):
+    _, _, args = _cli_frame(tmp_path / "in")
+    assert _cli(args + ["--out", tmp_path / "d.npy"] + extra) == 1
+    assert capsys.readouterr().err == message
