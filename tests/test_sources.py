@@ -1,12 +1,14 @@
 """Every training source from tiny fixture files in its real on-disk format: open, train a few steps, resume.
 
 Formats written here: NYU h5 (Ma et al.), KITTI depth completion (annotated + velodyne_raw + raw drive + calib),
-a user folder (rgb/ depth/ sparse/ intrinsics.txt) and `lipjax data render` shards. The network is the tiny
+a user folder (rgb/ depth/ sparse/ intrinsics.txt) and `lipjax data render` shards; TFDS nyu_depth_v2 comes from
+tfds.testing.mock_data when tensorflow-datasets is installed. The network is the tiny
 preset with one iteration and every test uses the same crop, so the train step compiles once for the file.
 """
 from __future__ import annotations
 
 import dataclasses
+import importlib.util
 import json
 import subprocess
 import sys
@@ -165,6 +167,19 @@ def test_trains_a_few_steps_and_resumes(tmp_path, source):
     assert [r for r in rows if r.get("split") == "val"][0]["rmse_m"] > 0
     _, meta = CheckpointManager(tmp_path / "run" / "checkpoints").restore(init_state(config))
     assert meta["data_loader"]["next_step"] == 3
+
+
+@pytest.mark.skipif(importlib.util.find_spec("tensorflow_datasets") is None, reason="pip install lipjax[tfds]")
+def test_nyu_tfds_trains_through_mock_data(tmp_path):
+    """TFDS nyu_depth_v2 read as a data source (no TensorFlow): random 480x640 frames from tfds.testing.mock_data,
+    through the nyu_paper protocol (256x320) and the crop."""
+    import tensorflow_datasets as tfds
+
+    data = dataclasses.replace(CONFIG.data, source="nyu_tfds", root=str(tmp_path / "tfds"))
+    with tfds.testing.mock_data(num_examples=4, policy=tfds.testing.MockPolicy.USE_CODE):
+        assert open_source(data, "val").dataset[0].shape == (256, 320)
+        state = loop.train(dataclasses.replace(CONFIG, name="tfds", data=data), tmp_path / "run", progress=False)
+    assert int(state.step) == 3
 
 
 def test_workers_resume_bit_identically(tmp_path):
