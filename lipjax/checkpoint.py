@@ -10,11 +10,13 @@ does restore. When none does, it raises CheckpointError, whose one-line message 
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import pathlib
 import shutil
 import sys
-from typing import Any
+import time
+from typing import Any, Iterator
 
 import flax.serialization
 import jax
@@ -38,6 +40,30 @@ def _first_line(exc: BaseException, limit: int = 160) -> str:
     text = next((line.strip() for line in str(exc).splitlines() if line.strip()), "")
     text = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+# How long the reads left in flight by a failed restore get to finish (local files: milliseconds).
+_DRAIN_S = 0.5
+
+
+@contextlib.contextmanager
+def _orbax_noise_silenced() -> Iterator[None]:
+    """Silences stderr (file descriptor 2) while checkpoints are tried: a failed orbax restore leaves reads in
+    flight whose completions each print a traceback ("Event loop is closed") from orbax's threads, hundreds of
+    lines for one damaged file. The failure itself is reported in one line. LIPJAX_DEBUG=1 keeps everything."""
+    if os.environ.get("LIPJAX_DEBUG"):
+        yield
+        return
+    sys.stderr.flush()
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), 2)
+            yield
+    finally:
+        sys.stderr.flush()
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 class CheckpointManager:
@@ -71,13 +97,17 @@ class CheckpointManager:
         steps = sorted(self.all_steps(), reverse=True)
         if not steps:
             raise FileNotFoundError(f"no checkpoint in {self.directory}")
-        failures = []
-        for candidate in steps:
-            try:
-                restored = self._restore(template, candidate)
-            except Exception as exc:  # noqa: BLE001 - any failure to read a checkpoint means it is unusable
-                failures.append((candidate, exc))
-                continue
+        failures, restored = [], None
+        with _orbax_noise_silenced():
+            for candidate in steps:
+                try:
+                    restored = self._restore(template, candidate)
+                    break
+                except Exception as exc:  # noqa: BLE001 - any failure to read a checkpoint means it is unusable
+                    failures.append((candidate, exc))
+            if failures:
+                time.sleep(_DRAIN_S)  # let the failed restore's reads in flight finish while stderr is silenced
+        if restored is not None:
             for bad, exc in failures:
                 moved = self._set_aside(bad)
                 print(f"lipjax: warning: checkpoint step {bad} in {self.directory} does not restore "

@@ -7,6 +7,8 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
                     [--uncertainty FILE] [--max-uncertainty M]
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
+    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
+    lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models
     lipjax --version
 
@@ -50,6 +52,7 @@ A frame above 2 Mpixel run without --max-side gets a one-line hint.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -87,10 +90,7 @@ def _intrinsics_from_args(args):
     from lipjax.pointcloud import as_intrinsics
 
     if getattr(args, "intrinsics", None):
-        try:
-            return as_intrinsics(args.intrinsics)
-        except ValueError as exc:
-            raise CLIError(f"--intrinsics {' '.join(f'{v:g}' for v in args.intrinsics)}: {exc}") from exc
+        return as_intrinsics(args.intrinsics)
     if getattr(args, "intrinsics_file", None):
         return read_intrinsics_txt(args.intrinsics_file)
     return None
@@ -286,6 +286,21 @@ def _cmd_data_render(args) -> int:
     return 0
 
 
+def _cmd_train(args) -> int:
+    from lipjax import model_io
+    from lipjax.train.folder import folder_config
+    from lipjax.train.run import run
+
+    model = model_io.load(args.init)[0]
+    data = {"root": args.data, "depth_scale": args.depth_scale, "num_workers": args.workers,
+            **({"crop": tuple(args.crop)} if args.crop else {}), **({"train_sampler": args.sampler} if args.sampler else {})}
+    config = folder_config(model, args.init, **data)
+    config = dataclasses.replace(config, **({"g_steps": args.steps} if args.steps else {}))
+    run(config, args.workdir or f"runs/train-{Path(args.data).resolve().name}", export=args.out,
+        progress=not args.quiet)
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------- parsing
 
 
@@ -374,6 +389,20 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--workers", type=console.positive_int, default=None, help="processes (default: every core)")
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=_cmd_data_render)
+
+    t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames (lipjax.train.folder)")
+    t.add_argument("--data", required=True, help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
+    t.add_argument("--out", required=True, help="model path stem to export to (then: lipjax complete --model OUT)")
+    t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
+    t.add_argument("--init", default="lip-cnn-indoor", help="model to start from: shipped name or saved path")
+    t.add_argument("--steps", type=console.positive_int, default=None, help="training steps (default 2000)")
+    t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
+                   "points), or input[:N] for your sparse/ maps (lipjax.data.sources)")
+    t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"), help="default 128 160")
+    t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")
+    t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<folder name>)")
+    t.add_argument("--quiet", action="store_true")
+    t.set_defaults(func=_cmd_train)
     return parser
 
 

@@ -62,13 +62,14 @@ def test_no_restorable_checkpoint_names_the_folder_to_move_away(tmp_path):
     assert sorted(p.name for p in directory.iterdir() if p.name.isdigit()) == ["1", "2"]  # nothing moved
 
 
-def test_training_resumes_from_the_previous_checkpoint_and_finishes(tmp_path, capsys):
+def test_training_resumes_from_the_previous_checkpoint_and_finishes(tmp_path, capfd):
+    # capfd, not capsys: orbax's threads write to file descriptor 2 directly
     workdir = tmp_path / "run"
     straight = loop.train(CONFIG, workdir, progress=False)  # checkpoints at steps 2 and 4
     _truncate_largest_file(workdir / "checkpoints" / "4")
-    capsys.readouterr()
+    capfd.readouterr()
     resumed = loop.train(CONFIG, workdir, progress=False)
-    captured = capsys.readouterr()
+    captured = capfd.readouterr()
     assert "resuming from step 2" in _one_line(captured.err)
     assert "resumed ckpt-test from step 2" in captured.out
     assert int(resumed.step) == CONFIG.total_steps

@@ -132,7 +132,7 @@ def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, t
     ("unknown_model", "unknown model 'no-such-model'"),
     ("too_many_iterations", "this model has 1 iterations"),
     ("ply_without_intrinsics", "intrinsics"),
-    ("zero_intrinsics", "--intrinsics 0 0 0 0: intrinsics fx=0 fy=0 cx=0 cy=0: the focal lengths fx, fy must be > 0"),
+    ("zero_intrinsics", "intrinsics fx=0 fy=0 cx=0 cy=0: the focal lengths fx, fy must be > 0"),
     ("model_files_mismatch", "bad.msgpack does not match bad.json (the config makes parameters ['log_rho', 'prox'], the file holds ['encoder'])"),
     ("model_json_bad_field", "bad.json: not a valid lipjax model config (TypeError: "),
     ("model_file_truncated", "bad.msgpack: cannot read the parameters, the file is damaged or truncated"),
