@@ -19,6 +19,7 @@ from lipjax.model import LIPConfig
 from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
+from lipjax.train.folder import folder_config
 
 INDOOR_MAX_DEPTH_M = 10.0
 OUTDOOR_MAX_DEPTH_M = 85.0
@@ -161,10 +162,6 @@ KITTI_PAPER_DATA = DataConfig(
     val_images=32, num_workers=8,
 )
 TARTANAIR_DATA = dataclasses.replace(NYU_PAPER_DATA, source="tartanair", protocol="tartanair")
-FOLDER_DATA = DataConfig(
-    source="folder", crop=(128, 160), train_sampler="uniform:200|uniform:500|bernoulli:200",
-    val_sampler="uniform:200", val_images=32, num_workers=2,
-)
 
 # lip_cnn_nyu. Protocol nyu_paper: NYU v2 h5 frames (Ma et al. layout), centre crop 464x580, resize 256x320; depth
 # 0-10 m. Sampler: 200 uniform ground-truth pixels (the paper's setting), keyed by frame id. Budget: 20000 steps x
@@ -211,11 +208,8 @@ LIP_CNN_TARTANAIR = dataclasses.replace(
 # (frames as they are, random 128x160 crops; --set data.crop=H,W). Sampler: a mixture of 200 / 500 uniform and
 # 200 Bernoulli points; "input" uses your own sparse/<stem> maps. PNG depth needs --set data.depth_scale=1000 (or
 # 256, 5000). Budget: 2000 steps x batch 8 = 16k images: ~15 min on a 2-core CPU at this repository's measured
-# ~20 images/s, well under a minute on one GPU (estimate). Also `lipjax train --config lip_cnn_folder --set ...`.
-LIP_CNN_FOLDER = dataclasses.replace(
-    LIP_CNN_INDOOR, name="lip-cnn-folder", data=FOLDER_DATA, init_from="lip-cnn-indoor", g_steps=2000,
-    learning_rate=2e-4, warmup_steps=100, eval_every=500, checkpoint_every=250,
-)
+# ~20 images/s, well under a minute on one GPU (estimate). The same run: `lipjax train --data DIR --out MODEL`.
+LIP_CNN_FOLDER = folder_config(LIP_CNN_INDOOR.model, "lip-cnn-indoor")  # = `lipjax train --data DIR`
 # The end-to-end baselines on the same data (Ma et al., U-Net, CSPN; the preset of the synthetic baselines above):
 # each takes its LIP+CNN run's data, protocol, sampler, batch size, loss and step budget, so its runtime is about
 # that run's (the networks have about LIP small's parameter count).

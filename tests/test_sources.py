@@ -193,21 +193,42 @@ def test_workers_resume_bit_identically(tmp_path):
         assert np.array_equal(np.asarray(a), np.asarray(b))
 
 
-def test_lip_cnn_folder_trains_exports_and_the_model_completes(tmp_path):
-    """The issue's "done when": the named config on a folder, exported to a given path, then `lipjax complete`."""
-    root = make_folder(tmp_path / "folder")
+def complete(model, rgb, depth, out, *extra):
+    return subprocess.run([sys.executable, "-m", "lipjax.cli", "complete", "--model", str(model), "--rgb", str(rgb),
+                           "--depth", str(depth), "--out", str(out), "--quiet", *extra], capture_output=True,
+                          text=True, timeout=600)
+
+
+def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path):
+    """The issue's "done when": the named config on NYU h5 files, exported to a given path, then `lipjax complete`
+    (the fixture frames are 30x40, so the nyu_paper crop is replaced by protocol none)."""
+    root = make_nyu(tmp_path / "nyu")
     model = tmp_path / "model"
-    args = ["--config", "lip_cnn_folder", "--workdir", str(tmp_path / "run"), "--no-progress", "--export", str(model),
-            "--set", f"data.root={root}", "--set", "data.depth_scale=1000", "--set", "data.crop=24,32",
-            "--set", "data.num_workers=0", "--set", "g_steps=2", "--set", "batch_size=2", "--set", "eval_every=0"]
+    args = ["--config", "lip_cnn_nyu", "--workdir", str(tmp_path / "run"), "--no-progress", "--export", str(model),
+            "--set", f"data.root={root}", "--set", "data.protocol=none", "--set", "data.crop=24,32",
+            "--set", "data.num_workers=1", "--set", "data.val_images=2", "--set", "g_steps=2",
+            "--set", "batch_size=2", "--set", "eval_every=0"]
     train = subprocess.run([sys.executable, "-m", "experiments.train", *args], capture_output=True, text=True,
                            timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
-    assert model.with_suffix(".json").is_file()
-    out = tmp_path / "out.npy"
-    done = subprocess.run([sys.executable, "-m", "lipjax.cli", "complete", "--model", str(model), "--rgb",
-                           str(root / "rgb" / "0000.png"), "--depth", str(root / "sparse" / "0000.png"),
-                           "--depth-scale", "1000", "--out", str(out), "--quiet"], capture_output=True, text=True,
-                          timeout=600)
+    rgb, depth = frame(0)
+    cv2.imwrite(str(tmp_path / "rgb.png"), rgb)
+    np.save(tmp_path / "sparse.npy", np.where(np.arange(H * W).reshape(H, W) % 13 == 0, depth, 0))
+    done = complete(model, tmp_path / "rgb.png", tmp_path / "sparse.npy", tmp_path / "out.npy")
     assert done.returncode == 0, done.stderr[-3000:]
-    assert np.load(out).shape == (H, W)
+    assert np.load(tmp_path / "out.npy").shape == (H, W)
+
+
+def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
+    """`lipjax train --data DIR` (= lip_cnn_folder: fine-tunes the shipped lip-cnn-indoor), then `lipjax complete`."""
+    root = make_folder(tmp_path / "folder")
+    model = tmp_path / "model"
+    train = subprocess.run([sys.executable, "-m", "lipjax.cli", "train", "--data", str(root), "--out", str(model),
+                            "--depth-scale", "1000", "--steps", "2", "--batch-size", "2", "--crop", "24", "32",
+                            "--workers", "0",
+                            "--workdir", str(tmp_path / "run"), "--quiet"], capture_output=True, text=True, timeout=600)
+    assert train.returncode == 0, train.stderr[-3000:]
+    done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
+                    "--depth-scale", "1000")
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert np.load(tmp_path / "out.npy").shape == (H, W)
