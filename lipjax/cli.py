@@ -295,7 +295,7 @@ def _cmd_train(args) -> int:
     data = {"root": args.data, "depth_scale": args.depth_scale, "num_workers": args.workers,
             **({"crop": tuple(args.crop)} if args.crop else {}), **({"train_sampler": args.sampler} if args.sampler else {})}
     config = folder_config(model, args.init, **data)
-    config = dataclasses.replace(config, **({"g_steps": args.steps} if args.steps else {}))
+    config = dataclasses.replace(config, batch_size=args.batch_size, **({"g_steps": args.steps} if args.steps else {}))
     run(config, args.workdir or f"runs/train-{Path(args.data).resolve().name}", export=args.out,
         progress=not args.quiet)
     return 0
@@ -396,6 +396,7 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", default="lip-cnn-indoor", help="model to start from: shipped name or saved path")
     t.add_argument("--steps", type=console.positive_int, default=None, help="training steps (default 2000)")
+    t.add_argument("--batch-size", type=console.positive_int, default=8)
     t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps (lipjax.data.sources)")
     t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"), help="default 128 160")
