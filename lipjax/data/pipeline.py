@@ -142,10 +142,9 @@ class BatchIterator:
 
 
 def with_host_inputs(model_config: Any, batch: Batch) -> Batch:
-    """Adds the host-computed initial estimate z0 (metres) to a (cropped) batch for models that need one."""
-    from lipjax.model import host_inputs_of  # imported here so data-only users do not import JAX
-
-    extra = host_inputs_of(model_config, batch.sparse)
+    """Adds the host-computed initial estimate z0 (metres) to a (cropped) batch for models that need one: the
+    model config's `host_inputs(sparse)`; None (no model) adds nothing."""
+    extra = model_config.host_inputs(batch.sparse) if hasattr(model_config, "host_inputs") else {}
     return dataclasses.replace(batch, **extra) if extra else batch
 
 

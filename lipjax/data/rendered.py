@@ -124,7 +124,7 @@ def _render_shard(spec: RenderSpec, shard: int, out: str) -> int:
         frame_rgb, frame_depth = _render_frame(spec, index)
         raw = np.rint(frame_depth.astype(np.float64) * scale)
         if raw.max() > np.iinfo(np.uint16).max:
-            raise ValueError(f"frame {index}: depth {frame_depth.max():.1f} m exceeds uint16 at scale {scale} per metre")
+            raise ValueError(f"frame {index}: depth {frame_depth.max():.1f} m exceeds uint16 at {scale} per metre")
         rgb[row], depth[row] = frame_rgb, raw.astype(np.uint16)
     arrays = {"rgb": rgb, "depth": depth}
     if spec.window:
