@@ -18,9 +18,9 @@ Data sets (each a Markdown table: rows = methods, columns = metrics with units, 
   Sparse inputs are drawn from the ground truth with the seed 0 and the sample id (lipjax.data.sampling), so
   the sampled pixels are also scored: mae_unsampled_m is the error on the pixels the methods had to invent.
 
-Methods: the four classical completers (lipjax.baselines.classical) and LIP+Wavelet: the unrolled ADMM solver
+Methods: the four classical completers (lipjax.classical) and LIP+Wavelet: the unrolled ADMM solver
 (lipjax.admm) with the wavelet soft-thresholding prox (lipjax.priors.wavelet), started from the box fill
-(lipjax.fill), as lipjax.baselines.lip_wavelet.LIPWavelet (settings chosen on val frames, see its docstring).
+(lipjax.fill), as lipjax.classical.lip_wavelet.LIPWavelet (settings chosen on val frames, see its docstring).
 
 Times are wall-clock ms per frame of the completer call on this machine (one warm-up call excluded); they
 depend on the machine and its load.
@@ -40,7 +40,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
 from lipjax.methods import get_method  # noqa: E402
-from lipjax.baselines.lip_wavelet import LIPWavelet  # noqa: E402
+from lipjax.classical.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
 

@@ -30,7 +30,6 @@ from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
 from lipjax.train.discriminator import Discriminator  # noqa: E402
 from lipjax.inference import compiled_apply, load_model  # noqa: E402
 from lipjax.train.losses import discriminator_loss  # noqa: E402
-from lipjax.model import host_inputs_of  # noqa: E402
 
 CROP = (128, 160)
 BATCH = 8
@@ -52,7 +51,7 @@ def crops(split: str, count: int, completer):
     out = {"rgb": [], "gt": [], "valid": [], "fake": []}
     for step, batch in enumerate(it):
         batch = augment_batch(batch, Augment(), CROP, seed=0, step=step)
-        fake = np.asarray(run(completer.params, batch.rgb, batch.sparse, host_inputs_of(completer.config, batch.sparse))[0])
+        fake = np.asarray(run(completer.params, batch.rgb, batch.sparse, completer.config.host_inputs(batch.sparse))[0])
         out["rgb"].append(batch.rgb.astype(np.float32) / 255.0)
         out["gt"].append(batch.gt)
         out["valid"].append(batch.gt_valid)

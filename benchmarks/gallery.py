@@ -26,7 +26,7 @@ try:
 except ImportError:  # the samplers are optional for this picture
     sampler_from_spec = None
 
-MAX_DEPTH_M = {"indoor": 10.0, "outdoor": synthetic.OUTDOOR_MAX_DEPTH_M}
+MAX_DEPTH_M = {"indoor": 10.0, "outdoor": synthetic.RENDER_FAR_CLIP_M}
 
 
 def sparse_input(sample, kind: str) -> np.ndarray:

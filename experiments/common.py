@@ -15,6 +15,7 @@ import numpy as np
 
 from lipjax.data.sample import Sample
 from lipjax.evaluate import EvalResult, evaluate, markdown_table
+from lipjax.inference import Completer
 from lipjax.methods import get_method
 
 
@@ -41,7 +42,7 @@ def evaluate_methods(
 
 def parameter_counts(completers: dict[str, Any]) -> dict[str, int | None]:
     """Learned parameters per method (None for methods without learned parameters)."""
-    return {name: (c.parameter_count() if hasattr(c, "parameter_count") else None) for name, c in completers.items()}
+    return {name: (c.parameter_count() if isinstance(c, Completer) else None) for name, c in completers.items()}
 
 
 def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],

@@ -12,17 +12,18 @@ from __future__ import annotations
 
 import dataclasses
 
-from lipjax.baselines.networks import baseline_preset
+from lipjax.networks import baseline_preset
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.train.discriminator import Discriminator
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
 from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.folder import folder_config
 
-INDOOR_MAX_DEPTH_M = 10.0
-OUTDOOR_MAX_DEPTH_M = 85.0
+INDOOR_MAX_DEPTH_M = SCENE_MAX_DEPTH_M["indoor"]  # the models' depth range (lipjax.interfaces)
+OUTDOOR_MAX_DEPTH_M = SCENE_MAX_DEPTH_M["outdoor"]
 
 INDOOR_DATA = DataConfig(
     kind="indoor", height=256, width=320, crop=(128, 160),
@@ -93,7 +94,7 @@ LIP_AD_OUTDOOR = dataclasses.replace(
     inverse_depth_floor_m=LIP_CNN_OUTDOOR.inverse_depth_floor_m,
 )
 
-# End-to-end learned baselines (lipjax.baselines.networks; Ma et al. [2], U-Net [6], CSPN [7]): the same data,
+# End-to-end learned baselines (lipjax.networks; Ma et al. [2], U-Net [6], CSPN [7]): the same data,
 # samplers, batch size, loss, schedule and step budget as the LIP+CNN run of their scene, with a "small" preset of
 # about LIP small's parameter count over its 3 iterations (1.48 M):
 #     ma2018_*  SparseToDense, ResNet-34 basic blocks at 1/4 width, random init   1,553,369 parameters

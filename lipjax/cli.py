@@ -98,8 +98,11 @@ def _intrinsics_from_args(args):
 
 def _model_max_depth(completer) -> float:
     """The depth range a model was made for (10 m indoor, 85 m outdoor), 10 m when it does not say."""
-    # every model config (LIP and the end-to-end baselines) states it; classical fills have no config
-    return float(getattr(getattr(completer, "config", None), "max_depth_m", 10.0))
+    from lipjax.inference import Completer
+    from lipjax.interfaces import SCENE_MAX_DEPTH_M
+
+    # every learned model states it (lipjax.interfaces); classical fills have none
+    return completer.config.max_depth_m if isinstance(completer, Completer) else SCENE_MAX_DEPTH_M["indoor"]
 
 
 # ------------------------------------------------------------------------------------------------ commands

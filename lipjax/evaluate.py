@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from lipjax.baselines.completer import DepthCompleter
+from lipjax.classical.completer import DepthCompleter
 from lipjax.data.sample import Sample
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 

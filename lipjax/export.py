@@ -55,11 +55,11 @@ def export_completer(completer: Completer, batch: int, height: int, width: int,
 
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
-    if getattr(config, "needs_host_initial_estimate", False):
-        specs.append(jax.ShapeDtypeStruct((batch, height, width), jnp.float32))
+    names = config.host_input_names  # host-computed inputs (the LIP model's z0) become extra inputs
+    specs += [jax.ShapeDtypeStruct((batch, height, width), jnp.float32) for _ in names]
 
-    def infer(rgb, sparse, *z0):
-        depth, _ = config.apply(params, rgb, sparse, **({"z0": z0[0]} if z0 else {}))
+    def infer(rgb, sparse, *extra):
+        depth, _ = config.apply(params, rgb, sparse, **dict(zip(names, extra)))
         return jnp.maximum(depth, 0.0)
 
     return jax.export.export(jax.jit(infer), platforms=platforms)(*specs)

@@ -21,7 +21,8 @@ import numpy as np
 
 from lipjax import model_io
 from lipjax.inputs import DEFAULT_MODELS, InputError, check_inputs, suggest_scene  # noqa: F401  (lipjax.InputError)
-from lipjax.model import LIPConfig, host_inputs_of
+from lipjax.interfaces import LearnedModel
+from lipjax.model import LIPConfig
 from lipjax.zbuffer import splat_nearest
 
 DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
@@ -30,7 +31,7 @@ DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
 @functools.lru_cache(maxsize=None)
 def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
     """jit(config.apply) as (params, rgb, sparse, extra) -> (depth, trajectory or None); extra holds the
-    host-computed inputs (`lipjax.model.host_inputs_of`), e.g. {"z0": ...}, or is empty."""
+    host-computed inputs (`config.host_inputs(sparse)`), e.g. {"z0": ...}, or is empty."""
 
     def run(params, rgb, sparse, extra):
         return config.apply(params, rgb, sparse, return_trajectory=return_trajectory, **extra)
@@ -42,7 +43,7 @@ def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
 class Completer:
     """A LIP model with its parameters, callable on images. Build with `load_model` or `Completer.random`."""
 
-    config: Any  # LIPConfig, or an end-to-end baseline's config (same init / apply interface)
+    config: LearnedModel  # a LIPConfig or an end-to-end network's config (lipjax.interfaces)
     params: Any
     name: str = "lip"
     metadata: dict = dataclasses.field(default_factory=dict)
@@ -55,7 +56,7 @@ class Completer:
 
     def with_iterations(self, num_iterations: int) -> "Completer":
         """The same model run for fewer iterations (uses the first K of its per-iteration operators)."""
-        if not hasattr(self.config, "num_iterations"):
+        if not self.config.iterative:
             raise ValueError(f"{self.name} is an end-to-end network, not an iterative LIP model: it has no iterations")
         if num_iterations == self.config.num_iterations:
             return self
@@ -72,15 +73,15 @@ class Completer:
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
-        rgb, sparse, batched = check_inputs(rgb, sparse, getattr(self.config, "max_depth_m", None), self.name)
-        depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
+        rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name)
+        depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, self.config.host_inputs(sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
-        rgb, sparse, _ = check_inputs(rgb, sparse, getattr(self.config, "max_depth_m", None), self.name)
-        return compiled_apply(self.config, True)(self.params, rgb, sparse, host_inputs_of(self.config, sparse))
+        rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name)
+        return compiled_apply(self.config, True)(self.params, rgb, sparse, self.config.host_inputs(sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)
@@ -118,7 +119,7 @@ def get_completer(model: Any = None, iterations: int | None = None, sparse: np.n
     else:
         completer = model
     if iterations is not None:
-        if not hasattr(completer, "with_iterations"):
+        if not isinstance(completer, Completer):
             raise ValueError(f"iterations apply to LIP models; {getattr(completer, 'name', model)!r} is not one")
         completer = completer.with_iterations(iterations)
     return completer

@@ -21,6 +21,7 @@ import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
 from lipjax.fill import box_fill_with_radius
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, register_model_type
 from lipjax.priors.base import SharedEncoderPrior
 from lipjax.priors.network import network_preset
 
@@ -34,8 +35,9 @@ Guidance = Literal["rgb", "rgb+mask"]
 Output = Literal["x", "z"]
 
 
+@register_model_type("lip")
 @dataclasses.dataclass(frozen=True)
-class LIPConfig:
+class LIPConfig(LearnedModel):
     """Everything that defines a LIP model except its learned parameters. Hashable (a static jit argument).
 
     Attributes:
@@ -69,18 +71,22 @@ class LIPConfig:
     guidance: Guidance = "rgb+mask"
     output: Output = "x"
 
-    # The model interface shared with the end-to-end baselines (lipjax.baselines): a hashable config object with
-    # init / apply / parameter_count, so that training, inference, export and model files treat them alike.
+    iterative = True  # lipjax.interfaces.LearnedModel: num_iterations, trajectories
+
     def init(self, key: jax.Array) -> "Params":
         return init(self, key)
 
-    def apply(self, params, rgb, sparse, weights=None, *, z0=None, return_trajectory: bool = False):
+    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False, z0=None):
         return apply(self, params, rgb, sparse, weights, z0=z0, return_trajectory=return_trajectory)
 
     @property
     def needs_host_initial_estimate(self) -> bool:
         """Whether `apply` needs z0 from `host_initial_estimate` (not jit-able)."""
         return self.initial_estimate in HOST_INITIAL_ESTIMATES
+
+    @property
+    def host_input_names(self) -> tuple[str, ...]:
+        return ("z0",) if self.needs_host_initial_estimate else ()
 
     def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
         """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse depth: {"z0": ...} or {}."""
@@ -94,8 +100,8 @@ class LIPConfig:
 
     @property
     def max_depth_m(self) -> float:
-        """Depth normalisation of the prior (metres); losses are computed in these units."""
-        return float(getattr(self.prior, "max_depth_m", 10.0))
+        """The depth range of the prior (metres): its normalisation and the unit of the training loss."""
+        return float(self.prior.max_depth_m)
 
     def __post_init__(self):
         if self.num_iterations < 1:
@@ -198,18 +204,13 @@ def apply(
     )
 
 
-def host_inputs_of(config: Any, sparse: np.ndarray) -> dict[str, np.ndarray]:
-    """`config.host_inputs(sparse)` for any model config; {} for models without host inputs (the baselines)."""
-    return config.host_inputs(sparse) if hasattr(config, "host_inputs") else {}
-
-
 def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
     """(B, H, W) float32 metres: the "linear" or "nearest" fill of each image of (B, H, W) sparse depth (0 = none).
 
     Images without any sample get zeros (the model's input checks reject them before this in inference).
     """
-    from lipjax.baselines.interpolate import linear_fill  # scipy-based; imported lazily (host only)
-    from lipjax.baselines.nearest import nearest_fill
+    from lipjax.classical.interpolate import linear_fill  # scipy-based; imported lazily (host only)
+    from lipjax.classical.nearest import nearest_fill
 
     fill = {"linear": linear_fill, "nearest": nearest_fill}[kind]
     sparse = np.asarray(sparse, np.float32)
@@ -229,7 +230,7 @@ def presets(name: str) -> LIPConfig:
     """Named model configurations: '<network preset>-<indoor|outdoor>', e.g. 'small-indoor', 'paper-outdoor'."""
     try:
         net, scene = name.split("-")
-        max_depth = {"indoor": 10.0, "outdoor": 85.0}[scene]
+        max_depth = SCENE_MAX_DEPTH_M[scene]
     except (ValueError, KeyError):
         raise ValueError(f"model preset must look like 'small-indoor' or 'paper-outdoor', got {name!r}") from None
     return LIPConfig(prior=network_preset(net, max_depth_m=max_depth))

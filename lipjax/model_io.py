@@ -20,6 +20,7 @@ import flax.serialization
 import jax
 import numpy as np
 
+from lipjax.interfaces import MODEL_TYPES, model_type_name
 from lipjax.model import LIPConfig
 from lipjax.priors.network import NetworkPrior
 
@@ -43,15 +44,11 @@ def _prior_types() -> dict[str, type]:
 
 
 def _model_types() -> dict[str, type]:
-    """Model config types by the name written in model files. End-to-end baselines register in
-    lipjax.baselines.networks (MODEL_TYPES): flat frozen dataclasses saved field by field."""
-    types: dict[str, type] = {"lip": LIPConfig}
-    try:
-        from lipjax.baselines.networks import MODEL_TYPES
-    except ImportError:  # the learned baselines are optional
-        MODEL_TYPES = {}
-    types.update(MODEL_TYPES)
-    return types
+    """Model config types by the name written in model files (lipjax.interfaces.MODEL_TYPES: the LIP model and
+    the end-to-end networks, flat frozen dataclasses saved field by field)."""
+    import lipjax.networks  # noqa: F401  (registers the end-to-end network types)
+
+    return MODEL_TYPES
 
 
 def _tuples(d: dict) -> dict:
@@ -60,9 +57,8 @@ def _tuples(d: dict) -> dict:
 
 def config_to_dict(config) -> dict:
     """A JSON-able dict of a model config, with its type named (inverse: config_from_dict)."""
-    model_type = {cls: name for name, cls in _model_types().items()}.get(type(config))
-    if model_type is None:
-        raise ValueError(f"cannot save a model config of unregistered type {type(config).__name__}")
+    _model_types()
+    model_type = model_type_name(config)
     if not isinstance(config, LIPConfig):
         return {"model_type": model_type, **dataclasses.asdict(config)}
     prior_type = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
@@ -145,8 +141,7 @@ def summary(name_or_path: str | os.PathLike) -> str:
         parts = ["LIP", f"{config.num_iterations} iterations", f"{prior} prox",
                  f"z0 = {config.initial_estimate} fill"]
     else:
-        model_type = {cls: name for name, cls in _model_types().items()}[type(config)]
-        parts = [f"{model_type} network (end to end)"]
+        parts = [f"{model_type_name(config)} network (end to end)"]
     return ", ".join(parts + [f"max depth {config.max_depth_m:g} m"])
 
 

@@ -4,17 +4,18 @@ import numpy as np
 import pytest
 from scipy import interpolate
 
-from lipjax.baselines.classical import (
+from lipjax.classical import (
     BatchFnCompleter,
     ColorizationFill,
     DepthCompleter,
     LinearFill,
     NearestFill,
-    classical_completers,
     nearest_fill,
 )
-from lipjax.baselines.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
-from lipjax.baselines.registry import COMPLETERS, make_completer
+from lipjax.classical.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
+from lipjax.methods import CLASSICAL, get_method
+
+FILLS = [CLASSICAL[name]() for name in CLASSICAL if name != "lip-wavelet"]
 
 
 def _random_sparse(h, w, n, seed=0, lo=1.0, hi=5.0):
@@ -31,7 +32,7 @@ def _gray(h, w, value=128):
 # ---------------------------------------------------------------- interface and input checks
 
 
-@pytest.mark.parametrize("completer", classical_completers(), ids=lambda c: c.name)
+@pytest.mark.parametrize("completer", FILLS, ids=lambda c: c.name)
 def test_output_contract(completer):
     s = _random_sparse(24, 30, 20)
     out = completer(_gray(24, 30), s)
@@ -46,7 +47,7 @@ def test_output_contract(completer):
     assert s[s > 0].min() - 1e-4 <= out[filled].min() and out.max() <= s.max() + 1e-4
 
 
-@pytest.mark.parametrize("completer", classical_completers(), ids=lambda c: c.name)
+@pytest.mark.parametrize("completer", FILLS, ids=lambda c: c.name)
 def test_invalid_inputs_raise_value_error(completer):
     rgb, s = _gray(8, 9), _random_sparse(8, 9, 5)
     with pytest.raises(ValueError, match="empty"):
@@ -67,10 +68,12 @@ def test_invalid_inputs_raise_value_error(completer):
 
 
 def test_registry():
-    assert set(COMPLETERS) == {c.name for c in classical_completers()}
-    assert make_completer("ip_basic_adaptive", radius_px=3).radius_px == 3
-    with pytest.raises(ValueError, match="unknown"):
-        make_completer("bicubic")
+    assert all(get_method(name).name == name for name in CLASSICAL)  # each method answers to its registered name
+    assert get_method("ip_basic_adaptive", radius_px=3).radius_px == 3
+    with pytest.raises(ValueError, match="unknown model 'bicubic'"):
+        get_method("bicubic")
+    with pytest.raises(ValueError, match="learned model"):
+        get_method("lip-ad-indoor", radius_px=3)
 
 
 def test_batch_fn_completer_wraps_a_jitted_batch_function():

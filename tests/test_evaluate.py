@@ -5,7 +5,7 @@ import jax
 import numpy as np
 import pytest
 
-from lipjax.baselines.classical import BatchFnCompleter, NearestFill
+from lipjax.classical import BatchFnCompleter, NearestFill
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.evaluate import EvalResult, evaluate, markdown_table, save_json
 from lipjax.metrics import compute_metrics

@@ -92,8 +92,8 @@ def test_fewer_iterations_uses_the_first_operators(completer):
 @pytest.mark.parametrize("kind", ["linear", "nearest"])
 def test_host_initial_estimate_untrained_model_returns_that_fill(kind):
     """With z_0 = a classical fill and the identity (untrained) prox, the model returns exactly that fill."""
-    from lipjax.baselines.interpolate import linear_fill
-    from lipjax.baselines.nearest import nearest_fill
+    from lipjax.classical.interpolate import linear_fill
+    from lipjax.classical.nearest import nearest_fill
 
     config = LIPConfig(prior=network_preset("tiny"), num_iterations=1, initial_estimate=kind)
     model = inference.Completer.random(config)

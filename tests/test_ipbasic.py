@@ -5,7 +5,7 @@ import cv2
 import numpy as np
 import pytest
 
-from lipjax.baselines.ipbasic import (
+from lipjax.classical.ipbasic import (
     IPBasicAdaptiveFill,
     IPBasicFill,
     IPBasicMultiscaleFill,
@@ -14,8 +14,8 @@ from lipjax.baselines.ipbasic import (
     ip_basic,
     ip_basic_multiscale,
 )
-from lipjax.baselines.nearest import nearest_fill
-from lipjax.baselines.registry import make_completer
+from lipjax.classical.nearest import nearest_fill
+from lipjax.methods import get_method
 from lipjax.data.sampling import LidarSampler
 from lipjax.data.synthetic.dataset import render
 from lipjax.methods import get_method
@@ -271,7 +271,7 @@ def test_registered_by_name():
     assert isinstance(get_method("ip_basic"), IPBasicFill)
     assert isinstance(get_method("ip_basic_multiscale"), IPBasicMultiscaleFill)
     assert isinstance(get_method("ip_basic_adaptive"), IPBasicAdaptiveFill)
-    assert make_completer("ip_basic", extrapolate=True).extrapolate
+    assert get_method("ip_basic", extrapolate=True).extrapolate
     rgb = np.zeros(FRAMES[1].shape + (3,), np.uint8)
     np.testing.assert_array_equal(get_method("ip_basic")(rgb, FRAMES[1]), ip_basic(FRAMES[1]))
 

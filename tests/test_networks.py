@@ -13,9 +13,9 @@ import pytest
 
 import lipjax
 from lipjax import model_io
-from lipjax.baselines.networks import (
+from lipjax.interfaces import MODEL_TYPES
+from lipjax.networks import (
     CSPN,
-    MODEL_TYPES,
     PRESETS,
     SparseToDense,
     UNet,
@@ -66,11 +66,11 @@ def test_preset_parameter_counts(model, size):
 def test_small_presets_are_about_the_size_of_lip_small_over_three_iterations():
     lip = lipjax.LIPConfig()  # small prior, K = 3
     lip_count = lip.parameter_count(jax.eval_shape(lip.init, jax.random.key(0)))
-    for model in MODEL_TYPES:
+    for model in PRESETS:
         assert abs(EXPECTED_PARAMETERS[(model, "small")] / lip_count - 1) < 0.1, model
 
 
-@pytest.mark.parametrize("name", sorted(MODEL_TYPES))
+@pytest.mark.parametrize("name", sorted(PRESETS))
 def test_output_has_input_size_is_finite_and_survives_a_model_file(name, tmp_path):
     config, params = _tiny(name)
     rgb, sparse = _inputs()

@@ -83,7 +83,7 @@ def test_outdoor_sky_is_invalid_and_depth_within_range():
         assert not s.valid.all()
         d = s.depth[s.valid]
         assert d.size > 0.4 * s.depth.size
-        assert 1.0 < d.min() and d.max() <= S.OUTDOOR_MAX_DEPTH_M
+        assert 1.0 < d.min() and d.max() <= S.RENDER_FAR_CLIP_M
         assert 1.4 <= info.camera_height_m <= 1.9
 
 
@@ -100,10 +100,10 @@ def _ground_check(kind: str, label: str, split: str, index: int, height: int, wi
     d_cam = np.stack([(u - k.cx) / k.fx, (v - k.cy) / k.fy, np.ones(u.size)])  # (3, n), float64
     expected = -c[1] / (R[1] @ d_cam)
     # only the part of the plane within range is valid (outdoor: 80 m, like a LiDAR)
-    np.testing.assert_array_equal(s.valid[on_plane], expected <= S.OUTDOOR_MAX_DEPTH_M)
+    np.testing.assert_array_equal(s.valid[on_plane], expected <= S.RENDER_FAR_CLIP_M)
     mask = on_plane & s.valid
     assert mask.sum() > 50, f"frame {s.id} shows too little {label} for the check"
-    keep = expected <= S.OUTDOOR_MAX_DEPTH_M
+    keep = expected <= S.RENDER_FAR_CLIP_M
     v, u, d_cam, expected = v[keep], u[keep], d_cam[:, keep], expected[keep]
     depth = s.depth[mask].astype(np.float64)
     np.testing.assert_allclose(depth, expected, rtol=1e-4)

@@ -86,7 +86,7 @@ def test_bad_shapes_and_empty_samples_are_errors():
 
 
 def test_ranks_the_linear_fill_error_on_a_synthetic_val_frame():
-    from lipjax.baselines.interpolate import linear_fill
+    from lipjax.classical.interpolate import linear_fill
     from lipjax.data.sampling import UniformSampler
     from lipjax.data.synthetic import SyntheticDataset
 

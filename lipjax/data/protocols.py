@@ -195,19 +195,19 @@ def apply_protocol(protocol: Protocol | str, sample: Sample) -> Sample:
 NYU_RAW_SIZE = (480, 640)
 NYU_PAPER_CROP = (464, 580)
 PAPER_SIZE = (256, 320)
-NYU_MAX_DEPTH_M = 10.0
-OUTDOOR_MAX_DEPTH_M = 80.0
+EVAL_MAX_DEPTH_INDOOR_M = 10.0
+EVAL_MAX_DEPTH_OUTDOOR_M = 80.0
 
 NYU_PAPER = Protocol(
-    "nyu_paper", (CenterCrop(*NYU_PAPER_CROP), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, NYU_MAX_DEPTH_M,
+    "nyu_paper", (CenterCrop(*NYU_PAPER_CROP), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "NYU v2 480x640 -> centre crop 464x580 (drops the white border, aspect 0.8) -> resize 256x320 (scale 0.5517).",
 )
 NYU_MA = Protocol(
-    "nyu_ma", (Resize(240, 320), CenterCrop(228, 304)), (228, 304), 0.0, NYU_MAX_DEPTH_M,
+    "nyu_ma", (Resize(240, 320), CenterCrop(228, 304)), (228, 304), 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "Ma & Karaman 2018 / CSPN / NLSPN: resize 480x640 -> 240x320, centre crop 228x304.",
 )
 KITTI_PAPER = Protocol(
-    "kitti_paper", (BottomCrop(256, 1216),), (256, 1216), 0.0, OUTDOOR_MAX_DEPTH_M,
+    "kitti_paper", (BottomCrop(256, 1216),), (256, 1216), 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "KITTI DC, bottom crop 256x1216 (the paper removes the top rows without LiDAR), columns centred.",
 )
 KITTI_SELECTION = Protocol(
@@ -215,15 +215,15 @@ KITTI_SELECTION = Protocol(
     "KITTI depth_selection crop 352x1216 (bottom, columns centred); all GT > 0 counts, as the official devkit.",
 )
 TARTANAIR = Protocol(
-    "tartanair", (CenterCrop(480, 600), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, OUTDOOR_MAX_DEPTH_M,
+    "tartanair", (CenterCrop(480, 600), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "TartanAir 480x640 -> centre crop 480x600 -> resize 256x320 (isotropic 0.5333), the NYU paper size.",
 )
 SYNTHETIC_INDOOR = Protocol(
-    "synthetic_indoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, NYU_MAX_DEPTH_M,
+    "synthetic_indoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "Embedded procedural indoor scenes, rendered at 256x320 (identity).",
 )
 SYNTHETIC_OUTDOOR = Protocol(
-    "synthetic_outdoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, OUTDOOR_MAX_DEPTH_M,
+    "synthetic_outdoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "Embedded procedural outdoor scenes, rendered at 256x320 (identity).",
 )
 SYNTHETIC = SYNTHETIC_INDOOR

@@ -14,13 +14,15 @@ Params = Any  # a pytree of arrays
 
 
 class Prior(Protocol):
-    """A proximal operator z = prox(v, rgb) with (possibly empty) parameters.
+    """A proximal operator z = prox(v, rgb) with (possibly empty) parameters, made for depths up to `max_depth_m`.
 
     Shapes and units:
       v:   (B, H, W) float32 depth in metres (x_{k+1} + u_k).
       rgb: (B, H, W, C) float32 in [0, 1]: the RGB guidance image (C = 3), possibly with extra channels.
       returns z: (B, H, W) float32 depth in metres.
     """
+
+    max_depth_m: float  # the depth range of the scenes it is made for, metres (lipjax.interfaces)
 
     def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> Params:
         """Parameters of ONE iteration's operator for images of size image_shape = (H, W) and a guidance image

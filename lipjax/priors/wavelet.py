@@ -172,12 +172,14 @@ class WaveletPrior:
       wavelet: "haar" or "db2".
       threshold_m: initial soft threshold tau in metres, returned by `init`.
       shifts: cycle-spinning shifts per axis (1 = none; shifts^2 transforms per call).
+      max_depth_m: the depth range of the scenes (metres; the Prior protocol's): the unit of a training loss.
     """
 
     levels: int = 4
     wavelet: str = "haar"
     threshold_m: float = 0.05
     shifts: int = 1
+    max_depth_m: float = 10.0
 
     def __post_init__(self):
         wavelet_filters(self.wavelet)  # validates the name

@@ -15,7 +15,7 @@ Every frame is ray-cast, in numpy on the CPU, from an analytic scene seen by a p
   moving cars (body, cabin with windows, wheels, lights, plates); street lamps, poles, signs; trees,
   hedges, bushes, fences, pedestrians; distant hills; a sky with clouds and sun glow. KITTI-like camera
   (`KITTI_INTRINSICS`), 1.45-1.85 m above the road (KITTI: 1.65 m), in a lane, yaw +-7 deg, pitch
-  -4..+2 deg, roll ~0.7 deg. Sky and surfaces farther than `OUTDOOR_MAX_DEPTH_M` (80 m, a LiDAR's range)
+  -4..+2 deg, roll ~0.7 deg. Sky and surfaces farther than `RENDER_FAR_CLIP_M` (80 m, a LiDAR's range)
   are invalid (depth 0); valid depth starts at ~3-5 m.
 
 RGB: procedural textures with per-object random colours (stripes, checkers, value noise, wood, tiles,
@@ -79,7 +79,7 @@ from lipjax.data.synthetic.constants import (
     LABELS,
     NYU_IMAGE_SIZE,
     NYU_INTRINSICS,
-    OUTDOOR_MAX_DEPTH_M,
+    RENDER_FAR_CLIP_M,
     SPLITS,
     SYNTHETIC_KINDS,
     TEST_SIZE,
@@ -109,7 +109,7 @@ __all__ = [
     "KITTI_IMAGE_SIZE",
     "KITTI_INTRINSICS",
     "KITTI_CAMERA_HEIGHT_M",
-    "OUTDOOR_MAX_DEPTH_M",
+    "RENDER_FAR_CLIP_M",
     "LABELS",
     "SceneInfo",
     "SyntheticDataset",

@@ -30,7 +30,7 @@ KITTI_IMAGE_SIZE = (375, 1242)
 KITTI_INTRINSICS = Intrinsics(fx=721.5, fy=721.5, cx=609.6, cy=172.9)
 KITTI_CAMERA_HEIGHT_M = 1.65
 # Outdoor surfaces farther than this are invalid (depth 0), like returns beyond a LiDAR's range.
-OUTDOOR_MAX_DEPTH_M = 80.0
+RENDER_FAR_CLIP_M = 80.0
 
 # Per-pixel semantic labels in SceneInfo.labels (index into this tuple).
 LABELS = (

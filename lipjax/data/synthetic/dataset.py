@@ -134,7 +134,7 @@ def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, widt
       height, width: render size in pixels (the scene does not depend on it).
     Returns:
       Sample with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
-      than OUTDOOR_MAX_DEPTH_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W),
+      than RENDER_FAR_CLIP_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W),
       id = "synthetic/{kind}/{split}/{index:06d}".
     """
     return render_with_info(kind, split, index, height, width)[0]

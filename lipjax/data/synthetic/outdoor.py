@@ -30,7 +30,7 @@ from lipjax.data.synthetic.constants import (
     _TERRAIN,
     _VEGETATION,
     _VEHICLE,
-    OUTDOOR_MAX_DEPTH_M,
+    RENDER_FAR_CLIP_M,
 )
 from lipjax.data.synthetic.geometry import _rot_z
 from lipjax.data.synthetic.materials import _Decal, _Mat
@@ -511,5 +511,5 @@ def _outdoor_scene(rng) -> _Scene:
         prims=b.prims, cam_pos=cam, cam_R=R,
         lights=[_Light(sun_c, direction=sun_dir, shadow_blur=1 if not overcast else 4)],
         ambient=ambient, ambient_up=rng.uniform(0.2, 0.5), extent=z_end + 600.0, sky=sky,
-        haze_dist=rng.uniform(300.0, 1500.0), haze_color=sky_hor * sky_gain * 0.8, max_depth=OUTDOOR_MAX_DEPTH_M,
+        haze_dist=rng.uniform(300.0, 1500.0), haze_color=sky_hor * sky_gain * 0.8, max_depth=RENDER_FAR_CLIP_M,
         terrain_x=ev, shadow_range=70.0, **_camera_model(rng))

@@ -1,4 +1,5 @@
-"""Hand-crafted depth completers, all behind the one `DepthCompleter` interface (lipjax.baselines.completer):
+"""Hand-crafted depth completers, all behind the one `DepthCompleter` interface (lipjax.classical.completer);
+by name through the one registry, lipjax.methods:
 
     completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
@@ -16,10 +17,10 @@ baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
 """
 from __future__ import annotations
 
-from lipjax.baselines.colorization import ColorizationFill, colorization_fill
-from lipjax.baselines.completer import BatchFnCompleter, DepthCompleter
-from lipjax.baselines.interpolate import LinearFill, linear_fill
-from lipjax.baselines.ipbasic import (
+from lipjax.classical.colorization import ColorizationFill, colorization_fill
+from lipjax.classical.completer import BatchFnCompleter, DepthCompleter
+from lipjax.classical.interpolate import LinearFill, linear_fill
+from lipjax.classical.ipbasic import (
     IPBasicAdaptiveFill,
     IPBasicFill,
     IPBasicMultiscaleFill,
@@ -27,7 +28,7 @@ from lipjax.baselines.ipbasic import (
     ip_basic_adaptive,
     ip_basic_multiscale,
 )
-from lipjax.baselines.nearest import NearestFill, nearest_fill
+from lipjax.classical.nearest import NearestFill, nearest_fill
 from lipjax.inputs import check_frame
 
 __all__ = [
@@ -40,7 +41,6 @@ __all__ = [
     "LinearFill",
     "NearestFill",
     "check_frame",
-    "classical_completers",
     "colorization_fill",
     "ip_basic",
     "ip_basic_adaptive",
@@ -49,8 +49,3 @@ __all__ = [
     "nearest_fill",
 ]
 
-
-def classical_completers() -> list[DepthCompleter]:
-    """One instance of each classical completer with its default parameters."""
-    return [NearestFill(), LinearFill(), IPBasicFill(), IPBasicMultiscaleFill(), IPBasicAdaptiveFill(),
-            ColorizationFill()]

@@ -18,7 +18,7 @@ import dataclasses
 import numpy as np
 from scipy import spatial
 
-from lipjax.baselines.nearest import nearest_fill
+from lipjax.classical.nearest import nearest_fill
 from lipjax.inputs import check_frame
 
 # Barycentric coordinates down to -eps count as inside, so pixels exactly on an edge are never lost to rounding.

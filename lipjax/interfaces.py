@@ -1,0 +1,86 @@
+"""The one interface every learned depth-completion model implements, and the one table of model types.
+
+A learned model is a hashable, frozen dataclass config (a static jit argument) with functional init / apply on a
+plain parameter pytree. The LIP model (lipjax.model.LIPConfig) and the end-to-end networks (lipjax.networks)
+implement it; training, inference (lipjax.inference.Completer), export and model files (lipjax.model_io) use
+only this interface, never the concrete classes. Model files name the type with `model_type_name`.
+
+Depth ranges: each meaning of "max depth" has one home.
+- A model's `max_depth_m` (here): the depth range it is made for, metres; the network's input normalisation and
+  the unit of its training loss. Per scene: `SCENE_MAX_DEPTH_M`.
+- The evaluation cap of a protocol: lipjax.data.protocols (EVAL_MAX_DEPTH_*_M).
+- The synthetic renderer's far clip: lipjax.data.synthetic.constants.RENDER_FAR_CLIP_M.
+"""
+from __future__ import annotations
+
+import abc
+from typing import Any, ClassVar
+
+import jax
+import numpy as np
+
+Params = Any
+
+# The depth range (metres) a model of each scene is made for: indoor rooms (Kinect, NYU) and streets (KITTI LiDAR).
+SCENE_MAX_DEPTH_M: dict[str, float] = {"indoor": 10.0, "outdoor": 85.0}
+
+MODEL_TYPES: dict[str, type] = {}
+
+
+def register_model_type(name: str):
+    """Class decorator: records a LearnedModel subclass under `name`, the type name written in model files."""
+
+    def register(cls: type) -> type:
+        if name in MODEL_TYPES and MODEL_TYPES[name] is not cls:
+            raise ValueError(f"model type {name!r} is already registered to {MODEL_TYPES[name].__name__}")
+        MODEL_TYPES[name] = cls
+        return cls
+
+    return register
+
+
+def model_type_name(config: "LearnedModel | type") -> str:
+    """The registered type name of a model config (or of its class)."""
+    kind = config if isinstance(config, type) else type(config)
+    for name, cls in MODEL_TYPES.items():
+        if kind is cls:
+            return name
+    raise ValueError(f"{kind.__name__} is not a registered model type (lipjax.interfaces.register_model_type)")
+
+
+class LearnedModel(abc.ABC):
+    """A learned completion model: config + init / apply over a parameter pytree.
+
+    apply(params, rgb (B, H, W, 3) uint8 or [0, 1] float, sparse (B, H, W) metres (0 = no sample), weights=None,
+    *, return_trajectory=False, **host_inputs) -> (depth (B, H, W) metres, trajectory or None). `host_inputs`
+    are the arrays `host_inputs(sparse)` computes outside the compiled program (e.g. the LIP model's z0).
+    """
+
+    # Iterative models (the unrolled LIP solver) have `num_iterations` and per-iteration trajectories.
+    iterative: ClassVar[bool] = False
+
+    @abc.abstractmethod
+    def init(self, key: jax.Array) -> Params:
+        """Random parameters (shapes independent of the image size)."""
+
+    @abc.abstractmethod
+    def apply(self, params: Params, rgb, sparse, weights=None, *, return_trajectory: bool = False, **host_inputs):
+        """Completes a batch (see the class docstring)."""
+
+    @abc.abstractmethod
+    def parameter_count(self, params: Params) -> int:
+        """Learned network parameters."""
+
+    @property
+    @abc.abstractmethod
+    def max_depth_m(self) -> float:
+        """The depth range the model is made for, metres (see the module docstring)."""
+
+    @property
+    def host_input_names(self) -> tuple[str, ...]:
+        """Names of the keyword inputs `host_inputs` returns (an exported model takes them as extra inputs)."""
+        return ()
+
+    def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
+        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse metres; none by default."""
+        return {}

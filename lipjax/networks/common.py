@@ -1,0 +1,63 @@
+"""Pieces shared by the end-to-end networks: the network input, GroupNorm, sub-pixel upsampling, the base class."""
+from __future__ import annotations
+
+import math
+
+import flax.linen as nn
+import jax
+import jax.numpy as jnp
+
+from lipjax.interfaces import LearnedModel, model_type_name
+from lipjax.model import parameter_count
+
+def group_norm(channels: int) -> nn.GroupNorm:
+    """GroupNorm with up to 8 groups; the group count must divide the channels (12 channels -> 4 groups)."""
+    return nn.GroupNorm(num_groups=math.gcd(8, channels))
+
+
+def network_input(rgb: jax.Array, sparse: jax.Array, max_depth_m: float, multiple: int) -> jax.Array:
+    """concat(sparse / max_depth_m, rgb - 0.5): (B, H', W', 4), H' and W' padded up to `multiple`.
+
+    RGB is edge-padded (keeps border statistics); sparse depth is zero-padded (0 = no sample: padding must not
+    invent measurements).
+    """
+    rgb = rgb.astype(jnp.float32) / 255.0 if rgb.dtype == jnp.uint8 else rgb.astype(jnp.float32)
+    _, h, w = sparse.shape
+    pad = ((0, 0), (0, (-h) % multiple), (0, (-w) % multiple))
+    d = jnp.pad(sparse.astype(jnp.float32) / max_depth_m, pad)
+    c = jnp.pad(rgb, pad + ((0, 0),), mode="edge") - 0.5
+    return jnp.concatenate([d[..., None], c], axis=-1)
+
+
+def depth_to_space2(h: jax.Array, features: int) -> jax.Array:
+    """(B, H, W, 4 * features) -> (B, 2H, 2W, features)."""
+    b, hh, ww, _ = h.shape
+    h = h.reshape(b, hh, ww, 2, 2, features).transpose(0, 1, 3, 2, 4, 5)
+    return h.reshape(b, 2 * hh, 2 * ww, features)
+
+
+class NetworkModel(LearnedModel):
+    """init / parameter_count shared by the end-to-end networks (each defines `module()`, `multiple`, `apply`)."""
+
+    def init(self, key: jax.Array):
+        """Random parameters. Shapes do not depend on the image size (fully convolutional): init on the smallest
+        input the network accepts."""
+        n = self.multiple
+        x = jnp.zeros((1, n, n, 4), jnp.float32)
+        return self.module().init(key, x)["params"]
+
+    def parameter_count(self, params) -> int:
+        return parameter_count(params)
+
+    @classmethod
+    def preset(cls, size: str, max_depth_m: float = 10.0):
+        """A preset by size ('paper', 'small', 'tiny') with the depth normalisation of the target scenes (metres)."""
+        from lipjax.networks import baseline_preset  # the presets table imports every network module
+
+        return baseline_preset(model_type_name(cls), size, max_depth_m)
+
+
+def check_max_depth(max_depth_m: float) -> None:
+    if not max_depth_m > 0:
+        raise ValueError(f"max_depth_m must be > 0 metres, got {max_depth_m}")
+

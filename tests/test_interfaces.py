@@ -1,0 +1,38 @@
+"""The one model interface and the one registry: every learned model type implements LearnedModel, by name."""
+import dataclasses
+
+import pytest
+
+import lipjax.networks  # noqa: F401  (registers the end-to-end network types)
+from lipjax import methods
+from lipjax.interfaces import MODEL_TYPES, SCENE_MAX_DEPTH_M, LearnedModel, model_type_name, register_model_type
+from lipjax.model import LIPConfig, presets
+from lipjax.networks import PRESETS
+
+
+def test_every_model_type_is_a_learned_model_and_named_both_ways():
+    assert set(MODEL_TYPES) == {"lip", *PRESETS}
+    for name, cls in MODEL_TYPES.items():
+        assert issubclass(cls, LearnedModel)
+        assert model_type_name(cls) == name
+    assert LIPConfig.iterative and not any(MODEL_TYPES[n].iterative for n in PRESETS)
+    assert LIPConfig().host_input_names == ()  # box fill: computed inside the program
+    assert dataclasses.replace(LIPConfig(), initial_estimate="linear").host_input_names == ("z0",)
+
+
+def test_a_type_name_cannot_be_taken_twice_and_unknown_types_are_named():
+    with pytest.raises(ValueError, match="already registered"):
+        register_model_type("lip")(type("Other", (), {}))
+    with pytest.raises(ValueError, match="not a registered model type"):
+        model_type_name(object())
+
+
+def test_scene_depth_ranges_reach_the_models():
+    assert presets("small-outdoor").max_depth_m == SCENE_MAX_DEPTH_M["outdoor"]
+    assert PRESETS["unet"]["tiny"].preset("tiny", SCENE_MAX_DEPTH_M["indoor"]).max_depth_m == 10.0
+
+
+def test_the_registry_names_every_hand_crafted_method():
+    assert {"nearest", "linear", "ip_basic", "ip_basic_multiscale", "ip_basic_adaptive", "colorization",
+            "lip-wavelet"} == set(methods.CLASSICAL)
+    assert set(methods.CLASSICAL) <= set(methods.available_methods("indoor"))
