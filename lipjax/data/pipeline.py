@@ -144,7 +144,7 @@ class BatchIterator:
 def with_host_inputs(model_config: Any, batch: Batch) -> Batch:
     """Adds the host-computed initial estimate z0 (metres) to a (cropped) batch for models that need one: the
     model config's `host_inputs(sparse)`; None (no model) adds nothing."""
-    extra = model_config.host_inputs(batch.sparse) if hasattr(model_config, "host_inputs") else {}
+    extra = {} if model_config is None else model_config.host_inputs(batch.sparse)
     return dataclasses.replace(batch, **extra) if extra else batch
 
 
