@@ -138,6 +138,33 @@ def test_kitti_input_is_the_real_scan_and_folder_input_its_sparse_maps(tmp_path)
         open_source(dataclasses.replace(CONFIG.data, source="nyu_h5"), "train")
 
 
+def test_tartanair_and_kitti_odometry_sources_split_without_overlap(tmp_path):
+    for t in range(20):  # TartanAir: 20 trajectories of 2 frames, split 90/5/5 by trajectory
+        for f in range(2):
+            base = tmp_path / "tartanair" / f"env{t % 4}" / "Easy" / f"P{t:03d}"
+            rgb, depth = frame(t * 2 + f)
+            write_rgb(base / "image_left" / f"{f:06d}_left.png", rgb)
+            (base / "depth_left").mkdir(exist_ok=True)
+            np.save(base / "depth_left" / f"{f:06d}_left_depth.npy", depth)
+    data = dataclasses.replace(CONFIG.data, source="tartanair", root=str(tmp_path / "tartanair"), val_images=40,
+                               protocol="none")
+    train, val = open_source(data, "train"), open_source(data, "val")
+    ids = [{s.dataset[i].id.rsplit("/", 1)[0] for i in range(len(s.dataset))} for s in (train, val)]
+    assert ids[0] and ids[1] and not ids[0] & ids[1]
+    for seq in ("00", "01"):  # KITTI odometry: the last 5 % of each sequence (>= 1 frame) validates
+        d = tmp_path / "odometry" / "sequences" / seq
+        (d / "image_2").mkdir(parents=True)
+        (d / "velodyne").mkdir()
+        (d / "calib.txt").write_text("P2: 20 0 20 0 0 20 15 0 0 0 1 0\nTr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n")
+        for f in range(4):
+            cv2.imwrite(str(d / "image_2" / f"{f:06d}.png"), frame(f)[0])
+            np.array([[4.0, 0.0, 0.0, 1.0], [6.0, 0.5, 0.2, 1.0]], np.float32).tofile(d / "velodyne" / f"{f:06d}.bin")
+    data = dataclasses.replace(CONFIG.data, source="kitti_odometry", root=str(tmp_path / "odometry"), protocol="none")
+    train, val = open_source(data, "train"), open_source(data, "val")
+    assert [val.dataset[i].id for i in range(len(val.dataset))] == ["kitti_odometry/00/000003", "kitti_odometry/01/000003"]
+    assert len(train.dataset) == 6 and np.count_nonzero(train.sampler(train.dataset[0])) == 2
+
+
 def test_rendered_shards_hold_the_on_the_fly_frames(tmp_path):
     out = render_to_disk("indoor", "train", 5, tmp_path / "r", height=H, width=W, workers=2, shard_size=2,
                          progress=False)
