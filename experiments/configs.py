@@ -3,6 +3,11 @@
     python -m experiments.train --config lip_cnn_indoor            # ~1 h on 2 idle CPU cores
     python -m experiments.train --config lip_ad_indoor             # needs lip_cnn_indoor's weights first
     python -m experiments.train --config smoke                     # seconds after compilation: a check, not a model
+    python -m experiments.train --config lip_cnn_nyu --set data.root=DIR --export runs/lip_cnn_nyu/model   # real data
+
+Real data sets and your own folders: lip_cnn_nyu, lip_ad_nyu, lip_cnn_kitti, lip_ad_kitti, lip_cnn_tartanair,
+lip_cnn_folder and the baselines on them (below, each with its protocol, sampler, budget and estimated runtime).
+Nothing is exported unless --export PATH is given.
 
 Shipped weights (lipjax/weights/<name>) come from these configs, trained on the embedded synthetic data:
 random 128x160 crops of 256x320 indoor renders, or 128x208 crops of 128x416 outdoor (KITTI-aspect) renders,
