@@ -21,6 +21,7 @@ the same code.
 from __future__ import annotations
 
 import dataclasses
+import gc
 import math
 from typing import Any, Iterator, Sequence
 
@@ -234,10 +235,12 @@ class TrainLoader:
         return Batch(**arrays)
 
     def close(self) -> None:
-        """Stops the worker processes."""
-        close = getattr(self._iterator, "close", None)
-        if close is not None:
-            close()
+        """Stops the worker processes and frees grain's iterators now (not at interpreter exit, where their
+        finalisers fail noisily)."""
+        if self._iterator is not None:
+            self._iterator.close()
+            self._iterator = None
+            gc.collect()
 
     def __enter__(self) -> "TrainLoader":
         return self
