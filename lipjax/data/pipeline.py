@@ -192,6 +192,13 @@ def _grain():
     return grain
 
 
+def _single_threaded_worker(worker_index: int, worker_count: int) -> None:
+    """Each worker process uses one core: OpenCV's own thread pool would make the workers compete for cores."""
+    import cv2
+
+    cv2.setNumThreads(1)
+
+
 class TrainLoader:
     """Training batches of steps [first_step, len(steps)) from `num_workers` grain worker processes, in order.
 
@@ -211,7 +218,8 @@ class TrainLoader:
             grain.ReadOptions(num_threads=1, prefetch_buffer_size=WORKER_BUFFER))
         if num_workers > 0:
             dataset = dataset.mp_prefetch(grain.MultiprocessingOptions(num_workers=num_workers,
-                                                                       per_worker_buffer_size=WORKER_BUFFER))
+                                                                       per_worker_buffer_size=WORKER_BUFFER),
+                                          worker_init_fn=_single_threaded_worker)
         self._iterator = iter(dataset)
         if state is not None:
             self._iterator.set_state(state["grain"])
