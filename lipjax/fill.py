@@ -61,3 +61,32 @@ def box_fill_with_radius(y: jax.Array, weights: jax.Array) -> tuple[jax.Array, j
 def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
     """Dense fill of sparse depth (see box_fill_with_radius): (..., H, W) metres in, (..., H, W) metres out."""
     return box_fill_with_radius(y, weights)[0]
+
+
+def sample_radius(weights: jax.Array) -> jax.Array:
+    """(..., H, W) weights >= 0 -> (..., H, W) float32: `box_fill_with_radius`'s radius map, without the fill.
+
+    The same windows and the same rule (the smallest r in 1, 2, 4, ... whose (2r+1)^2 window holds a sample,
+    weight > 1e-6; 0 at a sample), from one summed-area table of the sample count read by slicing for every r,
+    instead of two cumulative sums and gathers per r. Counts are exact in float32 up to 2^24 pixels.
+    """
+    h, w = weights.shape[-2:]
+    measured = (weights > 1e-6).astype(jnp.float32)
+    lead = [(0, 0)] * (weights.ndim - 2)
+    table = jnp.pad(jnp.cumsum(jnp.cumsum(measured, axis=-2), axis=-1), lead + [(1, 0), (1, 0)])
+    radius_map = jnp.zeros(weights.shape, jnp.float32)
+    found = measured > 0
+    radius = 1
+    while True:
+        # table[i, j] = count in rows < i, cols < j; edge padding clamps the window to the image
+        t = jnp.pad(table, lead + [(radius, radius), (radius, radius)], mode="edge")
+        hi_r, lo_r = slice(2 * radius + 1, 2 * radius + 1 + h), slice(0, h)
+        hi_c, lo_c = slice(2 * radius + 1, 2 * radius + 1 + w), slice(0, w)
+        count = t[..., hi_r, hi_c] - t[..., lo_r, hi_c] - t[..., hi_r, lo_c] + t[..., lo_r, lo_c]
+        new = ~found & (count > 0.5)
+        radius_map = jnp.where(new, float(radius), radius_map)
+        found = found | new
+        if radius >= max(h, w):
+            break
+        radius *= 2
+    return radius_map

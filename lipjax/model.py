@@ -20,7 +20,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
-from lipjax.fill import box_fill_with_radius
+from lipjax.fill import box_fill_with_radius, sample_radius
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, register_model_type
 from lipjax.priors.base import SharedEncoderPrior
 from lipjax.priors.network import network_preset
@@ -175,7 +175,10 @@ def apply(
     if weights is None:
         weights = (sparse > 0).astype(jnp.float32)
     guidance = _rgb_to_unit(rgb)
-    fill, radius = box_fill_with_radius(sparse, weights)
+    if config.initial_estimate == "box_fill":
+        fill, radius = box_fill_with_radius(sparse, weights)
+    else:
+        radius = sample_radius(weights)  # the same radius map, without computing the fill
     if config.needs_host_initial_estimate:
         if z0 is None:
             raise ValueError(f"initial_estimate={config.initial_estimate!r} is computed on the host: pass "

@@ -1,7 +1,9 @@
 """The box fill used as ADMM's z_0: exact at samples, exact on constants, nearest-ish elsewhere."""
+import jax.numpy as jnp
 import numpy as np
+import pytest
 
-from lipjax.fill import box_fill, box_fill_with_radius
+from lipjax.fill import box_fill, box_fill_with_radius, sample_radius
 
 
 def test_samples_are_kept_and_radius_measures_distance_to_a_sample():
@@ -32,3 +34,13 @@ def test_constant_depth_is_reproduced_everywhere():
 def test_empty_image_stays_zero():
     y = np.zeros((1, 5, 5), np.float32)
     assert not np.asarray(box_fill(y, y)).any()
+
+
+@pytest.mark.parametrize("shape,p", [((2, 13, 21), 0.01), ((1, 40, 64), 0.002), ((1, 7, 300), 0.2)])
+def test_sample_radius_equals_the_box_fills_radius(shape, p):
+    rng = np.random.default_rng(0)
+    mask = (rng.random(shape) < p).astype(np.float32)
+    mask.reshape(-1)[0] = 1.0  # at least one sample
+    y = mask * rng.uniform(1, 5, shape).astype(np.float32)
+    expected = box_fill_with_radius(jnp.asarray(y), jnp.asarray(mask))[1]
+    np.testing.assert_array_equal(sample_radius(jnp.asarray(mask)), expected)
