@@ -292,8 +292,9 @@ def _parse_value(text: str, annotation: str, current, key: str):
             if text.lower() not in ("true", "false"):
                 raise ValueError
             return text.lower() == "true"
-        if kind in (tuple, "tuple"):  # e.g. a crop: "128,160"
-            return tuple(int(v) for v in text.split(","))
+        if kind in (tuple, "tuple"):  # e.g. a crop "128,160", or a zoom range "0.75,1.33" (float like the field)
+            element = float if any(isinstance(v, float) for v in current or ()) else int
+            return tuple(element(v) for v in text.split(","))
         return {"int": int, "float": float, "str": str}.get(kind, kind)(text)
     except ValueError:
         want = "true or false" if kind in (bool, "bool") else getattr(kind, "__name__", kind)
