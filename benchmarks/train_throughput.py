@@ -6,7 +6,8 @@
    z0 fill, all in the grain worker processes) for each source, with each worker count. Real formats are written
    first, at their real frame sizes, as a few fixture frames in a temporary folder (NYU h5 480x640, KITTI DC
    375x1242 PNGs, a folder of 480x640 PNGs, `lipjax data render` shards); frames repeat, so the page cache
-   holds them, as it would for a data set on a local SSD. The first batch (worker start-up) is not timed.
+   holds them, as it would for a data set on a local SSD. The first batch (worker start-up) is not timed; the
+   worker counts are measured in turn, `--rounds` times, and the median is reported.
 2. Host cost: milliseconds of CPU per frame for that work in one process, per source, at the 128x160 crop.
 3. Train step: images/s of the jitted supervised step of each named config at batch 8 on its training crop
    (compilation not timed), on this machine's JAX backend.
@@ -152,6 +153,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=24, help="timed batches of 8 per measurement")
     p.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    p.add_argument("--rounds", type=int, default=3, help="measurements per worker count (median reported)")
     p.add_argument("--sources", nargs="+", default=list(SOURCES), choices=SOURCES)
     p.add_argument("--models", nargs="*", default=["lip_cnn_indoor", "lip_fast_indoor", "ma2018_indoor",
                                                    "unet_indoor", "cspn_indoor"])
@@ -174,7 +176,9 @@ def main() -> None:
         for name in args.sources:
             data = dataclasses.replace(base, source=name, **overrides[name])
             host = host_ms_per_frame(data, LIP_CNN_INDOOR.model, max(2, args.steps // 4))
-            rates = [pipeline_rate(data, LIP_CNN_INDOOR.model, w, args.steps) for w in args.workers]
+            rounds = [[pipeline_rate(data, LIP_CNN_INDOOR.model, w, args.steps) for w in args.workers]
+                      for _ in range(args.rounds)]  # interleaved, so that a burst of other load hits all counts
+            rates = [float(np.median(r)) for r in zip(*rounds)]
             print(f"| {name} | {host:.1f} | " + " | ".join(f"{r:.1f}" for r in rates)
                   + f" | {rates[-1] / rates[0]:.2f}x |", flush=True)
     if args.models:
