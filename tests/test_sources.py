@@ -262,3 +262,13 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
                     "--depth-scale", "1000")
     assert done.returncode == 0, done.stderr[-3000:]
     assert np.load(tmp_path / "out.npy").shape == (H, W)
+
+
+def test_lipjax_data_render_command(tmp_path, capsys):
+    from lipjax import cli
+
+    args = ["data", "render", "--kind", "outdoor", "--count", "2", "--height", "16", "--width", "24", "--workers", "1",
+            "--out", str(tmp_path / "r"), "--quiet"]
+    assert cli.main(args) == 0 and len(RenderedDataset(tmp_path / "r")) == 2
+    assert cli.main(args[:5] + ["3"] + args[6:]) == 1  # another render into the same folder: a one-line error
+    assert "already holds a different render" in capsys.readouterr().err
