@@ -161,7 +161,8 @@ def test_tartanair_and_kitti_odometry_sources_split_without_overlap(tmp_path):
             np.array([[4.0, 0.0, 0.0, 1.0], [6.0, 0.5, 0.2, 1.0]], np.float32).tofile(d / "velodyne" / f"{f:06d}.bin")
     data = dataclasses.replace(CONFIG.data, source="kitti_odometry", root=str(tmp_path / "odometry"), protocol="none")
     train, val = open_source(data, "train"), open_source(data, "val")
-    assert [val.dataset[i].id for i in range(len(val.dataset))] == ["kitti_odometry/00/000003", "kitti_odometry/01/000003"]
+    val_ids = [val.dataset[i].id for i in range(len(val.dataset))]
+    assert val_ids == ["kitti_odometry/00/000003", "kitti_odometry/01/000003"]
     assert len(train.dataset) == 6 and np.count_nonzero(train.sampler(train.dataset[0])) == 2
 
 

@@ -51,7 +51,8 @@ def evaluate_params(model_config, params, batches: list[Batch], max_depth_m: flo
     for b in batches:
         pred = np.asarray(apply(params, b.rgb, b.sparse, {} if b.z0 is None else {"z0": b.z0})[0])
         for i in range(len(pred)):
-            agg.add(compute_metrics(pred[i], b.gt[i], b.gt_valid[i], b.sparse[i], min_depth_m=0.0, max_depth_m=max_depth_m))
+            agg.add(compute_metrics(pred[i], b.gt[i], b.gt_valid[i], b.sparse[i], min_depth_m=0.0,
+                                    max_depth_m=max_depth_m))
     return agg.means()
 
 
@@ -64,7 +65,8 @@ def _initial_g_params(config: TrainConfig):
         return None
     init_config, params, _ = model_io.load(config.init_from)
     if init_config != config.model:
-        raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, but this run needs {config.model}")
+        raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, but this run needs "
+                         f"{config.model}; train from scratch with --set init_from=None or pick a matching model")
     return params
 
 
@@ -171,7 +173,8 @@ def train(
     return state
 
 
-def export(config: TrainConfig, state: TrainState, path: str | os.PathLike, metadata: dict[str, Any] | None = None) -> None:
+def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
+           metadata: dict[str, Any] | None = None) -> None:
     """Saves the trained G as a loadable model (lipjax.load_model(path))."""
     params = jax.tree_util.tree_map(to_host, state.g_params)
     meta = {"train_config": config.name, "steps": int(state.step), **(metadata or {})}
