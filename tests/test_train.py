@@ -51,6 +51,11 @@ def test_smoke_run_goes_through_all_phases_logs_and_exports(straight_run, tmp_pa
     assert len(val) == 1 and val[0]["rmse_m"] > 0
     loop.export(CONFIG, state, tmp_path / "model")
     model = lipjax.load_model(tmp_path / "model")
+    assert model.metadata["images_seen"] == CONFIG.total_steps * CONFIG.batch_size  # the budget, recorded
+    # a run started from that model adds its budget to the one it started with
+    follow = dataclasses.replace(CONFIG, init_from=str(tmp_path / "model"))
+    loop.export(follow, state, tmp_path / "model2")
+    assert lipjax.load_model(tmp_path / "model2").metadata["images_seen"] == 2 * CONFIG.total_steps * CONFIG.batch_size
     rgb = np.zeros((24, 32, 3), np.uint8)
     sparse = np.zeros((24, 32), np.float32)
     sparse[5, 5] = 2.0
