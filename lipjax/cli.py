@@ -78,7 +78,8 @@ def _depth_scale(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number or one of {sorted(KNOWN_DEPTH_SCALES)}, got {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"expected a number or one of {sorted(KNOWN_DEPTH_SCALES)}, got {text!r}") from None
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
     return value
@@ -224,7 +225,8 @@ def _cmd_evaluate(args) -> int:
     min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
     max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
     if max_depth is None:
-        raise CLIError("give the evaluated depth range: --max-depth-m M (e.g. 10 indoors, 80 outdoors) or --protocol NAME")
+        raise CLIError("give the evaluated depth range: --max-depth-m M (e.g. 10 indoors, 80 outdoors) "
+                       "or --protocol NAME")
     columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
     results = {}
     for model in args.model or [None]:
@@ -296,7 +298,8 @@ def _cmd_train(args) -> int:
 
     model = model_io.load(args.init)[0]
     data = {"root": args.data, "depth_scale": args.depth_scale, "num_workers": args.workers,
-            **({"crop": tuple(args.crop)} if args.crop else {}), **({"train_sampler": args.sampler} if args.sampler else {})}
+            **({"crop": tuple(args.crop)} if args.crop else {}),
+            **({"train_sampler": args.sampler} if args.sampler else {})}
     config = folder_config(model, args.init, **data)
     config = dataclasses.replace(config, batch_size=args.batch_size, **({"g_steps": args.steps} if args.steps else {}))
     run(config, args.workdir or f"runs/train-{Path(args.data).resolve().name}", export=args.out,
@@ -312,27 +315,33 @@ def build_parser() -> argparse.ArgumentParser:
     from lipjax.data import protocols
     from lipjax.data.folder import OUT_FORMATS
 
-    parser = console.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = console.ArgumentParser(prog=PROG, description=__doc__,
+                                    formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
-    c.add_argument("--depth", required=True, help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
+    c.add_argument("--depth", required=True,
+                   help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
     c.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
-                   help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output (default 256)")
+                   help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output "
+                        "(default 256)")
     c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path "
                    "(also any lipjax.methods name, e.g. ip_basic)")
-    c.add_argument("--iterations", type=console.positive_int, default=None, metavar="K", help="run the first K ADMM iterations")
+    c.add_argument("--iterations", type=console.positive_int, default=None, metavar="K",
+                   help="run the first K ADMM iterations")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, default=None, help="per-frame format with folder inputs")
-    c.add_argument("--max-side", type=console.positive_int, default=None, metavar="N", help="run larger frames downsized to this longer side")
+    c.add_argument("--max-side", type=console.positive_int, default=None, metavar="N",
+                   help="run larger frames downsized to this longer side")
     c.add_argument("--color-range", type=float, nargs=2, default=None, metavar=("MIN_M", "MAX_M"),
                    help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
     c.add_argument("--ply", default=None, help="also write a coloured point cloud (.ply; a folder with folder inputs)")
     intr = c.add_mutually_exclusive_group()
-    intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"), help="pixels, of the RGB image")
+    intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"),
+                      help="pixels, of the RGB image")
     intr.add_argument("--intrinsics-file", default=None, metavar="F", help='"fx fy cx cy" or the 9 numbers of K')
     c.add_argument("--uncertainty", default=None, metavar="FILE",
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
@@ -341,26 +350,33 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     c.set_defaults(func=_cmd_complete)
 
-    e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
+    e = sub.add_parser("evaluate",
+                       help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
                    help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
                         "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
     e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
     e.add_argument("--data", default="synthetic-indoor",
-                   help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ (lipjax.data.folder layout)")
+                   help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ "
+                        "(lipjax.data.folder layout)")
     e.add_argument("--split", default="test", choices=("train", "val", "test"), help="synthetic split")
-    e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"), help="synthetic render size (default 256 320)")
-    e.add_argument("--sampler", default="uniform:200", help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling)")
-    e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS), help="named crop/resize + depth range applied to each frame (lipjax.data.protocols)")
+    e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
+                   help="synthetic render size (default 256 320)")
+    e.add_argument("--sampler", default="uniform:200",
+                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling)")
+    e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS),
+                   help="named crop/resize + depth range applied to each frame (lipjax.data.protocols)")
     e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="for PNG ground truth in FOLDER")
     intr = e.add_mutually_exclusive_group()
     intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"))
     intr.add_argument("--intrinsics-file", default=None, metavar="F")
     e.add_argument("--min-depth-m", type=float, default=None)
     e.add_argument("--max-depth-m", type=float, default=None, help="default: the protocol's (10 indoor, 80 outdoor)")
-    e.add_argument("--limit", type=console.positive_int, default=None, metavar="N", help="evaluate the first N frames only")
+    e.add_argument("--limit", type=console.positive_int, default=None, metavar="N",
+                   help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
-    e.add_argument("--columns", default=None, help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
+    e.add_argument("--columns", default=None,
+                   help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
     e.add_argument("--json", default=None, metavar="FILE", help="also write all results as JSON")
     e.add_argument("--quiet", action="store_true")
     e.set_defaults(func=_cmd_evaluate)
@@ -385,7 +401,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--split", default="train", choices=("train", "val", "test"))
     r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
     r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
-    r.add_argument("--height", type=console.positive_int, default=None, help="full frame (default 256x320 indoor, 128x416 outdoor)")
+    r.add_argument("--height", type=console.positive_int, default=None,
+                   help="full frame (default 256x320 indoor, 128x416 outdoor)")
     r.add_argument("--width", type=console.positive_int, default=None)
     r.add_argument("--window", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="store one HxW window per frame, rendered directly at the training crop size")
@@ -394,7 +411,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.set_defaults(func=_cmd_data_render)
 
     t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames (lipjax.train.folder)")
-    t.add_argument("--data", required=True, help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
+    t.add_argument("--data", required=True,
+                   help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
     t.add_argument("--out", required=True, help="model path stem to export to (then: lipjax complete --model OUT)")
     t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", default="lip-cnn-indoor", help="model to start from: shipped name or saved path")
@@ -402,7 +420,8 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--batch-size", type=console.positive_int, default=8)
     t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps (lipjax.data.sources)")
-    t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"), help="default 128 160")
+    t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
+                   help="default 128 160")
     t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")
     t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<folder name>)")
     t.add_argument("--quiet", action="store_true")

@@ -49,7 +49,8 @@ def positive_int_list(text: str) -> list[int]:
     try:
         return [positive_int(item) for item in text.split(",")]
     except argparse.ArgumentTypeError:
-        raise argparse.ArgumentTypeError(f"expected comma-separated positive integers, e.g. 1,2,3, got {text!r}") from None
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated positive integers, e.g. 1,2,3, got {text!r}") from None
 
 
 def one_line(exc: BaseException) -> str:

@@ -136,7 +136,8 @@ def evaluate(
         pred = np.asarray(completer(sample.rgb, sparse))
         dt_ms = 1000.0 * (time.perf_counter() - t0)
         if pred.shape != sample.depth.shape:
-            raise ValueError(f"{name}: prediction shape {pred.shape} != ground truth {sample.depth.shape} ({sample.id})")
+            raise ValueError(f"{name}: prediction shape {pred.shape} != ground truth {sample.depth.shape} "
+                             f"({sample.id})")
         m = compute_metrics(
             pred, sample.depth, sample.valid, sparse,
             min_depth_m=min_depth_m, max_depth_m=max_depth_m, pred_floor_m=pred_floor_m,

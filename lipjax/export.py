@@ -104,7 +104,8 @@ class ExportedCompleter:
         if rgb.shape != (b, h, w, 3) or rgb.dtype != np.uint8:
             raise ValueError(f"this exported model takes rgb uint8 {(b, h, w, 3)}, got {rgb.dtype} {rgb.shape}")
         if sparse.shape != (b, h, w) or not np.issubdtype(sparse.dtype, np.floating):
-            raise ValueError(f"this exported model takes sparse float32 metres {(b, h, w)}, got {sparse.dtype} {sparse.shape}")
+            raise ValueError(f"this exported model takes sparse float32 metres {(b, h, w)}, "
+                             f"got {sparse.dtype} {sparse.shape}")
         args = [rgb, sparse.astype(np.float32)]
         if self.needs_z0:
             if z0 is None or np.shape(z0) != (b, h, w):
@@ -121,5 +122,6 @@ def load_exported(path: str | os.PathLike) -> ExportedCompleter:
     try:
         exported = jax.export.deserialize(bytearray(blob))
     except Exception as exc:  # noqa: BLE001 - flatbuffer / version errors all mean "not a usable export file"
-        raise ValueError(f"{os.fspath(path)!r} is not a jax.export file this jax can read ({type(exc).__name__}: {exc})") from exc
+        raise ValueError(f"{os.fspath(path)!r} is not a jax.export file this jax can read "
+                         f"({type(exc).__name__}: {exc})") from exc
     return ExportedCompleter(exported)

@@ -68,7 +68,8 @@ class Completer:
             params["prox"] = jax.tree_util.tree_map(lambda a: a[:num_iterations], params["prox"])
         if "log_rho" in params:
             log_rho = np.asarray(params["log_rho"])
-            params["log_rho"] = np.resize(log_rho, num_iterations) if self.config.shared_prox else log_rho[:num_iterations]
+            params["log_rho"] = (np.resize(log_rho, num_iterations) if self.config.shared_prox
+                                 else log_rho[:num_iterations])
         return Completer(config, params, self.name, self.metadata)
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:

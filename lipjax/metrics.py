@@ -83,7 +83,8 @@ def _as_2d(name: str, a: Any, dtype) -> np.ndarray:
 
 
 def evaluation_mask(
-    gt: np.ndarray, valid: np.ndarray, *, min_depth_m: float = DEFAULT_MIN_DEPTH_M, max_depth_m: float = DEFAULT_MAX_DEPTH_M
+    gt: np.ndarray, valid: np.ndarray, *, min_depth_m: float = DEFAULT_MIN_DEPTH_M,
+    max_depth_m: float = DEFAULT_MAX_DEPTH_M
 ) -> np.ndarray:
     """(H, W) bool mask E of the pixels that are scored: valid, finite ground truth in (min, max] metres."""
     gt = np.asarray(gt)

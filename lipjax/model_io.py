@@ -1,7 +1,7 @@
 """Saving and loading a trained LIP model: a config (JSON) and parameters (flax msgpack). No pickle.
 
-A model on disk is two files side by side: `<stem>.json` (the model config, with its type and its prior's type named) and
-`<stem>.msgpack` (the parameter pytree, `flax.serialization.msgpack_serialize`). Models shipped with the package
+A model on disk is two files side by side: `<stem>.json` (the model config, with its type and its prior's type named)
+and `<stem>.msgpack` (the parameter pytree, `flax.serialization.msgpack_serialize`). Models shipped with the package
 live in `lipjax/weights/` and load by name, e.g. `load("lip-cnn-indoor")`.
 
 The stem is used as given: `save("out/smoke.v2", ...)` writes `out/smoke.v2.json` and `out/smoke.v2.msgpack`.

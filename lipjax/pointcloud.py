@@ -91,7 +91,8 @@ def write_ply(path: str | os.PathLike, points: np.ndarray, colors: np.ndarray | 
     fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
     if colors is not None:
         fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
-    header = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0", "comment lipjax point cloud, metres",
+    header = ["ply", f"format {'binary_little_endian' if binary else 'ascii'} 1.0",
+              "comment lipjax point cloud, metres",
               f"element vertex {len(points)}"]
     header += [f"property {'float' if t == '<f4' else 'uchar'} {name}" for name, t in fields]
     header += ["end_header"]

@@ -38,7 +38,8 @@ def _lut(cmap: str) -> np.ndarray:
     try:
         colormap = matplotlib.colormaps[cmap]
     except KeyError:
-        raise ValueError(f"unknown colour map {cmap!r} (any matplotlib colour map name, e.g. 'turbo', 'magma')") from None
+        raise ValueError(f"unknown colour map {cmap!r} "
+                         f"(any matplotlib colour map name, e.g. 'turbo', 'magma')") from None
     return np.round(colormap(np.linspace(0.0, 1.0, 256))[:, :3] * 255).astype(np.uint8)
 
 

@@ -91,7 +91,8 @@ def read_depth(path: str | os.PathLike, scale: float | None = None) -> np.ndarra
         if raw is None:
             raise dataset_error("Cannot read depth PNG (missing, corrupt or not an image)", path)
         if raw.dtype != np.uint16 or raw.ndim != 2:
-            raise dataset_error(f"Depth PNG must be single-channel 16-bit, got {raw.dtype} with shape {raw.shape}", path)
+            raise dataset_error(
+                f"Depth PNG must be single-channel 16-bit, got {raw.dtype} with shape {raw.shape}", path)
         depth = raw.astype(np.float32) / np.float32(scale)
     else:
         raise dataset_error(f"Unsupported depth format {suffix!r} (use .png with a scale, or .npy in metres)", path)
@@ -133,7 +134,8 @@ def read_frame(rgb_path: str | os.PathLike, depth_path: str | os.PathLike,
     if sparse.shape != rgb.shape[:2]:
         raise ValueError(f"{depth_path}: sparse depth is {sparse.shape[0]}x{sparse.shape[1]} but the RGB image "
                          f"{rgb_path} is {rgb.shape[0]}x{rgb.shape[1]}; the depth must be aligned with the RGB image "
-                         "pixel for pixel (project your LiDAR into the camera: lipjax.pointcloud.project_lidar_to_depth)")
+                         "pixel for pixel (project your LiDAR into the camera: "
+                         "lipjax.pointcloud.project_lidar_to_depth)")
     if not (sparse > 0).any():
         raise ValueError(f"{depth_path}: the sparse depth map is empty (no pixel > 0); nothing to complete from")
     return rgb, sparse
@@ -189,7 +191,8 @@ def _list(directory: Path, suffixes: tuple[str, ...]) -> dict[str, Path]:
     for path in sorted(directory.iterdir()):
         if path.is_file() and path.suffix.lower() in suffixes:
             if path.stem in found:
-                raise dataset_error(f"Two files share the stem {path.stem!r} ({found[path.stem].name})", path, FOLDER_LAYOUT)
+                raise dataset_error(f"Two files share the stem {path.stem!r} ({found[path.stem].name})", path,
+                                    FOLDER_LAYOUT)
             found[path.stem] = path
     return found
 

@@ -31,7 +31,8 @@ KITTI_DC_LAYOUT = """\
 <raw_root>/<date>/calib_cam_to_cam.txt                              (P_rect_02 / P_rect_03)"""
 KITTI_DC_SOURCE = (
     "KITTI depth completion https://www.cvlibs.net/datasets/kitti/eval_depth.php?benchmark=depth_completion "
-    "(data_depth_annotated.zip, data_depth_velodyne.zip) + KITTI raw https://www.cvlibs.net/datasets/kitti/raw_data.php "
+    "(data_depth_annotated.zip, data_depth_velodyne.zip) + "
+    "KITTI raw https://www.cvlibs.net/datasets/kitti/raw_data.php "
     "(synced+rectified drives and calibration)"
 )
 KITTI_SELECTION_LAYOUT = """\
@@ -92,7 +93,8 @@ class KittiFrame:
 
     def __post_init__(self):
         if self.lidar.shape != self.sample.shape or self.lidar.dtype != np.float32:
-            raise ValueError(f"{self.sample.id}: lidar must be float32 {self.sample.shape}, got {self.lidar.dtype} {self.lidar.shape}")
+            raise ValueError(f"{self.sample.id}: lidar must be float32 {self.sample.shape}, "
+                             f"got {self.lidar.dtype} {self.lidar.shape}")
 
     def apply_protocol(self, protocol) -> "KittiFrame":
         """The frame after a protocols.Protocol: same crop for the GT sample and the LiDAR scan."""
@@ -134,7 +136,8 @@ class _KittiBase:
     def __getitem__(self, index: int) -> Sample:
         rgb, depth = self.rgb(index), self._target(index)
         if depth.shape != rgb.shape[:2]:
-            raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ for {self.ids[index]}", self._where(index))
+            raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ for {self.ids[index]}",
+                                self._where(index))
         return Sample.from_depth(rgb, depth, self.intrinsics(index), self.ids[index])
 
     def frame(self, index: int) -> KittiFrame:
@@ -177,7 +180,8 @@ class KittiDepthCompletion(_KittiBase):
         entries = []
         for camera in cameras:
             for path in listed.glob(f"*/proj_depth/{kind}/{camera}/*.png"):
-                entries.append((natural_key(path.parents[3].name), camera, natural_key(path.stem), path.parents[3].name, path.stem))
+                entries.append((natural_key(path.parents[3].name), camera, natural_key(path.stem),
+                                path.parents[3].name, path.stem))
         if not entries:
             raise dataset_error(f"No {kind} PNGs found under", listed, KITTI_DC_LAYOUT, KITTI_DC_SOURCE)
         entries.sort()
@@ -194,8 +198,10 @@ class KittiDepthCompletion(_KittiBase):
 
     def _paths(self, index: int) -> tuple[Path, Path, Path]:
         drive, camera, stem = self.frames[index]
-        gt = self.depth_root / "data_depth_annotated" / self.split / drive / "proj_depth" / "groundtruth" / camera / f"{stem}.png"
-        velo = self.depth_root / "data_depth_velodyne" / self.split / drive / "proj_depth" / "velodyne_raw" / camera / f"{stem}.png"
+        gt = (self.depth_root / "data_depth_annotated" / self.split / drive / "proj_depth" / "groundtruth" / camera
+              / f"{stem}.png")
+        velo = (self.depth_root / "data_depth_velodyne" / self.split / drive / "proj_depth" / "velodyne_raw" / camera
+                / f"{stem}.png")
         rgb = self.raw_root / drive[:10] / drive / camera / "data" / f"{stem}.png"
         return rgb, gt, velo
 
@@ -240,7 +246,8 @@ class KittiSelection(_KittiBase):
                 root = candidate
                 break
         else:
-            raise dataset_error("KITTI val_selection_cropped/image not found under", root, KITTI_SELECTION_LAYOUT, KITTI_SELECTION_SOURCE)
+            raise dataset_error("KITTI val_selection_cropped/image not found under", root, KITTI_SELECTION_LAYOUT,
+                                KITTI_SELECTION_SOURCE)
         if target not in ("groundtruth", "velodyne_raw"):
             raise ValueError(f"target must be 'groundtruth' or 'velodyne_raw', got {target!r}")
         self.root, self.target = root, target
@@ -279,7 +286,8 @@ class KittiSelection(_KittiBase):
     def intrinsics(self, index: int) -> Intrinsics:
         path = self._path(index, "intrinsics")
         if not path.is_file():
-            raise dataset_error("KITTI selection intrinsics not found", path, KITTI_SELECTION_LAYOUT, KITTI_SELECTION_SOURCE)
+            raise dataset_error("KITTI selection intrinsics not found", path, KITTI_SELECTION_LAYOUT,
+                                KITTI_SELECTION_SOURCE)
         return read_intrinsics_txt(path)
 
     def _where(self, index: int) -> Path:

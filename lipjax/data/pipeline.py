@@ -73,9 +73,11 @@ class BatchIterator:
         self.process_index, self.process_count = process_index, process_count
         self.sample_seed = sample_seed
         self.num_examples = len(dataset)
-        self.steps_per_epoch = self.num_examples // batch_size if drop_last else math.ceil(self.num_examples / batch_size)
+        self.steps_per_epoch = (self.num_examples // batch_size if drop_last
+                                else math.ceil(self.num_examples / batch_size))
         if self.steps_per_epoch == 0:
-            raise ValueError(f"dataset of {self.num_examples} examples gives no batch of {batch_size} (drop_last={drop_last})")
+            raise ValueError(f"dataset of {self.num_examples} examples gives no batch of {batch_size} "
+                             f"(drop_last={drop_last})")
 
     @property
     def local_batch_size(self) -> int:

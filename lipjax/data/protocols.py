@@ -119,7 +119,8 @@ class Resize:
         if (in_h, in_w) == (self.height, self.width):
             return sample
         shrinking = self.height <= in_h and self.width <= in_w
-        rgb = cv2.resize(sample.rgb, (self.width, self.height), interpolation=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR)
+        rgb = cv2.resize(sample.rgb, (self.width, self.height),
+                         interpolation=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR)
         rows, cols = nearest_indices(in_h, self.height), nearest_indices(in_w, self.width)
         return Sample(
             np.ascontiguousarray(rgb),
@@ -162,7 +163,8 @@ class Protocol:
         for step in self.steps:
             sample = step.apply(sample)
         if sample.shape != self.output_size:
-            raise ValueError(f"protocol {self.name!r} produced {sample.shape} for {sample.id!r}, expected {self.output_size}")
+            raise ValueError(f"protocol {self.name!r} produced {sample.shape} for {sample.id!r}, "
+                             f"expected {self.output_size}")
         return sample
 
     def apply_to_depth(self, depth: np.ndarray) -> np.ndarray:

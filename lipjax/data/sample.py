@@ -66,14 +66,16 @@ class Sample:
                 f"got {self.depth.dtype} {self.depth.shape}"
             )
         if self.valid.dtype != np.bool_ or self.valid.shape != self.depth.shape:
-            raise ValueError(f"Sample {self.id!r}: valid must be bool {self.depth.shape}, got {self.valid.dtype} {self.valid.shape}")
+            raise ValueError(f"Sample {self.id!r}: valid must be bool {self.depth.shape}, "
+                             f"got {self.valid.dtype} {self.valid.shape}")
 
     @classmethod
     def from_depth(cls, rgb: np.ndarray, depth: np.ndarray, intrinsics: Intrinsics, id: str) -> "Sample":
         """Builds a Sample, deriving `valid` from depth (> 0 and finite) and zeroing invalid depth."""
         depth = np.asarray(depth, dtype=np.float32)
         valid = np.isfinite(depth) & (depth > 0)
-        return cls(np.ascontiguousarray(rgb, dtype=np.uint8), np.where(valid, depth, 0).astype(np.float32), valid, intrinsics, id)
+        return cls(np.ascontiguousarray(rgb, dtype=np.uint8), np.where(valid, depth, 0).astype(np.float32), valid,
+                   intrinsics, id)
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -349,10 +349,12 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
         overrides = _parse_options(options, spec)
         unknown = set(overrides) - fields
         if unknown:
-            raise ValueError(f"sampler spec {spec!r}: unknown LiDAR option(s) {sorted(unknown)}; known: {sorted(fields)}")
+            raise ValueError(f"sampler spec {spec!r}: unknown LiDAR option(s) {sorted(unknown)}; "
+                             f"known: {sorted(fields)}")
         sampler = LIDAR_PRESETS[preset](**overrides)
     else:
-        raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N or lidar:{'|'.join(LIDAR_PRESETS)}")
+        raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N or "
+                         f"lidar:{'|'.join(LIDAR_PRESETS)}")
     if noise_text:
         name, _, options = noise_text.partition(":")
         if name.strip() != "noise":
@@ -360,6 +362,7 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
         raw = _parse_options(options, spec)
         unknown = set(raw) - set(_NOISE_KEYS)
         if unknown:
-            raise ValueError(f"sampler spec {spec!r}: unknown noise option(s) {sorted(unknown)}; known: {sorted(_NOISE_KEYS)}")
+            raise ValueError(f"sampler spec {spec!r}: unknown noise option(s) {sorted(unknown)}; "
+                             f"known: {sorted(_NOISE_KEYS)}")
         sampler = Noisy(sampler, Noise(**{_NOISE_KEYS[k]: v for k, v in raw.items()}))
     return sampler

@@ -37,11 +37,13 @@ def read_tartanair_depth(path: str | os.PathLike) -> np.ndarray:
     try:
         depth = np.load(path, allow_pickle=False)
     except Exception as exc:  # noqa: BLE001 - any decode failure is one user-facing problem
-        raise dataset_error(f"Cannot read TartanAir depth ({type(exc).__name__}: {exc})", path, TARTANAIR_LAYOUT, TARTANAIR_SOURCE) from exc
+        raise dataset_error(f"Cannot read TartanAir depth ({type(exc).__name__}: {exc})", path, TARTANAIR_LAYOUT,
+                            TARTANAIR_SOURCE) from exc
     if depth.ndim == 3 and depth.shape[2] == 1:
         depth = depth[..., 0]
     if depth.ndim != 2 or not np.issubdtype(depth.dtype, np.floating):
-        raise dataset_error(f"TartanAir depth must be float (H, W), got {depth.dtype} {depth.shape}", path, TARTANAIR_LAYOUT)
+        raise dataset_error(f"TartanAir depth must be float (H, W), got {depth.dtype} {depth.shape}", path,
+                            TARTANAIR_LAYOUT)
     depth = depth.astype(np.float32)
     if np.any(depth < 0):
         raise dataset_error("TartanAir depth has negative values", path, TARTANAIR_LAYOUT)
@@ -66,7 +68,8 @@ class TartanAirDataset:
                  difficulties: tuple[str, ...] = TARTANAIR_DIFFICULTIES, intrinsics: Intrinsics = TARTANAIR_INTRINSICS):
         root = Path(root)
         if split != "all" and split not in TARTANAIR_SPLIT_FRACTIONS:
-            raise ValueError(f"TartanAir split must be one of {sorted(TARTANAIR_SPLIT_FRACTIONS)} or 'all', got {split!r}")
+            raise ValueError(f"TartanAir split must be one of {sorted(TARTANAIR_SPLIT_FRACTIONS)} or 'all', "
+                             f"got {split!r}")
         if not root.is_dir():
             raise dataset_error("TartanAir root not found", root, TARTANAIR_LAYOUT, TARTANAIR_SOURCE)
         trajectories: dict[str, list[str]] = {}
@@ -92,10 +95,12 @@ class TartanAirDataset:
     def __getitem__(self, index: int) -> Sample:
         trajectory, frame = self.frames[index]
         base = self.root / trajectory
-        rgb_path, depth_path = base / "image_left" / f"{frame}_left.png", base / "depth_left" / f"{frame}_left_depth.npy"
+        rgb_path, depth_path = (base / "image_left" / f"{frame}_left.png",
+                                base / "depth_left" / f"{frame}_left_depth.npy")
         if not depth_path.is_file():
             raise dataset_error("TartanAir depth file not found", depth_path, TARTANAIR_LAYOUT, TARTANAIR_SOURCE)
         rgb, depth = read_rgb(rgb_path), read_tartanair_depth(depth_path)
         if depth.shape != rgb.shape[:2]:
-            raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ", depth_path, TARTANAIR_LAYOUT)
+            raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ", depth_path,
+                                TARTANAIR_LAYOUT)
         return Sample.from_depth(rgb, depth, self.intrinsics, f"tartanair/{trajectory}/{frame}")

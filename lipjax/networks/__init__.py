@@ -41,7 +41,8 @@ __all__ = ["CSPN", "CSPNNet", "PRESETS", "SparseToDense", "SparseToDenseNet", "U
 PRESETS: dict[str, dict[str, object]] = {
     "sparse_to_dense": {
         "paper": SparseToDense(width_multiplier=1.0),       # ResNet-18 at full width (64)
-        # ResNet-34 at a quarter width: 1.55 M, the parameter budget of LIP small (ResNet-18 at a quarter width: 0.92 M).
+        # ResNet-34 at a quarter width: 1.55 M, the parameter budget of LIP small
+        # (ResNet-18 at a quarter width: 0.92 M).
         "small": SparseToDense(width_multiplier=0.25, blocks=(3, 4, 6, 3)),
         "tiny": SparseToDense(width_multiplier=0.125, blocks=(1, 1, 1, 1)),
     },

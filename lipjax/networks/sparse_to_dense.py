@@ -22,7 +22,8 @@ class BasicBlock(nn.Module):
     def __call__(self, h):
         shortcut = h
         if self.strides != 1 or h.shape[-1] != self.features:
-            shortcut = group_norm(self.features)(nn.Conv(self.features, (1, 1), strides=self.strides, use_bias=False)(h))
+            shortcut = group_norm(self.features)(
+                nn.Conv(self.features, (1, 1), strides=self.strides, use_bias=False)(h))
         y = nn.Conv(self.features, (3, 3), strides=self.strides, use_bias=False)(h)
         y = nn.relu(group_norm(self.features)(y))
         y = group_norm(self.features)(nn.Conv(self.features, (3, 3), use_bias=False)(y))

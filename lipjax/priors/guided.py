@@ -138,7 +138,8 @@ class GuidedPrior(SharedEncoderPrior):
             if len(getattr(self, name)) != 3:
                 raise ValueError(f"{name} must give 3 widths (1/2, 1/4, 1/8 resolution), got {getattr(self, name)}")
         if tuple(self.encoder_widths[1:]) != tuple(self.branch_widths[1:]):
-            raise ValueError("encoder_widths and branch_widths must agree at 1/4 and 1/8 resolution (features are added)")
+            raise ValueError("encoder_widths and branch_widths must agree at 1/4 and 1/8 resolution "
+                             "(features are added)")
 
     def _encoder(self) -> GuidanceEncoder:
         return GuidanceEncoder(tuple(self.encoder_widths))

@@ -14,7 +14,8 @@ def masked_mean(values: jax.Array, mask: jax.Array) -> jax.Array:
     return jnp.sum(values * mask) / jnp.maximum(jnp.sum(mask), 1.0)
 
 
-def depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, kind: str = "l2", scale_m: float = 1.0) -> jax.Array:
+def depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, kind: str = "l2",
+               scale_m: float = 1.0) -> jax.Array:
     """Masked L2 (mean squared) or L1 (mean absolute) error of (B, H, W) depths, in units of scale_m."""
     err = (pred - gt) / scale_m
     if kind == "l2":

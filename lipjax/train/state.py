@@ -30,7 +30,8 @@ def make_optimizers(config: TrainConfig) -> tuple[optax.GradientTransformation, 
         0.0, config.learning_rate, max(1, min(config.warmup_steps, config.total_steps - 1)),
         max(2, config.total_steps), end_value=0.05 * config.learning_rate,
     )
-    g_opt = optax.chain(optax.clip_by_global_norm(config.grad_clip_norm), optax.adamw(g_schedule, weight_decay=config.weight_decay))
+    g_opt = optax.chain(optax.clip_by_global_norm(config.grad_clip_norm),
+                        optax.adamw(g_schedule, weight_decay=config.weight_decay))
     d_opt = optax.chain(optax.clip_by_global_norm(config.grad_clip_norm), optax.adam(config.d_learning_rate, b1=0.5))
     return g_opt, d_opt
 

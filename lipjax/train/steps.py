@@ -1,7 +1,8 @@
 """jit-compiled, pure train steps: `step(state, batch, key) -> (state, metrics)`.
 
 `batch` is a dict of arrays: rgb (B,H,W,3) uint8, sparse (B,H,W) float32 m, gt (B,H,W) float32 m,
-gt_valid (B,H,W) bool, and z0 (B,H,W) float32 m for models with a host-computed initial estimate. Sharded over a 'data' mesh axis, the same jitted step runs data-parallel: XLA inserts the
+gt_valid (B,H,W) bool, and z0 (B,H,W) float32 m for models with a host-computed initial estimate.
+Sharded over a 'data' mesh axis, the same jitted step runs data-parallel: XLA inserts the
 gradient all-reduce, parameters stay replicated.
 """
 from __future__ import annotations

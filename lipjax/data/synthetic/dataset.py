@@ -183,4 +183,5 @@ class SyntheticDataset:
         return intrinsics_for(self.kind, self.height, self.width)
 
     def __repr__(self) -> str:
-        return f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, width={self.width})"
+        return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
+                f"width={self.width})")

@@ -259,7 +259,8 @@ def _outdoor_scene(rng) -> _Scene:
     crosswalk = rng.uniform(8, 40) if rng.random() < 0.25 else None
     terrain_kind = rng.random()
     grass = _p_noise(rng, _hsv(rng.uniform(0.13, 0.28), rng.uniform(0.3, 0.7), rng.uniform(0.15, 0.35)),
-                     _hsv(rng.uniform(0.1, 0.25), rng.uniform(0.2, 0.6), rng.uniform(0.3, 0.55)), rng.uniform(0.5, 3), 2,
+                     _hsv(rng.uniform(0.1, 0.25), rng.uniform(0.2, 0.6), rng.uniform(0.3, 0.55)),
+                     rng.uniform(0.5, 3), 2,
                      1.2)
     pave = _p_tiles(rng, _c_grey(rng, 0.35, 0.7), _c_grey(rng, 0.2, 0.5), rng.uniform(0.3, 1.0),
                     rng.uniform(0.3, 1.0), 0.01, 0.1)
