@@ -278,6 +278,8 @@ def _cmd_models(args) -> int:
         parts = [name + (" (default)" if name == DEFAULT_MODEL else ""), model_io.summary(name)]
         if rmse is not None:
             parts.append(f"val rmse_m={rmse:.4f} ({meta.get('val_sampler', '?')}, {meta.get('data', '?')})")
+        if "images_seen" in meta:
+            parts.append(f"trained on {meta['images_seen']:,} images")
         print("  ".join(parts))
     return 0
 

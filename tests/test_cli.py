@@ -258,6 +258,7 @@ def test_models_command_says_what_each_model_is(capsys):
     for line in out.splitlines():
         assert ("LIP, " in line and " iterations, " in line) or "network (end to end)" in line, line
         assert " max depth " in line and line.split(" max depth ")[1].split()[0].replace(".", "").isdigit(), line
+        assert " trained on " in line and line.endswith(" images"), line  # every shipped model states its budget
 
 
 def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
