@@ -101,8 +101,8 @@ def test_lidar_pattern_and_scene():
 
 def test_default_model_follows_the_input():
     assert inference.get_completer(sparse=_lidar(20.0)).name == "lip-ad-outdoor"
-    assert inference.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-ad-indoor"
-    assert inference.get_completer().name == "lip-ad-indoor"
+    assert inference.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-fast-indoor"
+    assert inference.get_completer().name == "lip-fast-indoor"
 
 
 def test_the_completer_checks_against_its_range():
