@@ -37,7 +37,8 @@ def depth_to_space2(h: jax.Array, features: int) -> jax.Array:
 
 
 class NetworkModel(LearnedModel):
-    """init / parameter_count shared by the end-to-end networks (each defines `module()`, `multiple`, `apply`)."""
+    """init / apply / parameter_count shared by the end-to-end networks (each defines `module()` and `multiple`;
+    CSPN overrides `apply` with its propagation)."""
 
     def init(self, key: jax.Array):
         """Random parameters. Shapes do not depend on the image size (fully convolutional): init on the smallest
@@ -45,6 +46,15 @@ class NetworkModel(LearnedModel):
         n = self.multiple
         x = jnp.zeros((1, n, n, 4), jnp.float32)
         return self.module().init(key, x)["params"]
+
+    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
+        """Dense depth (B, H, W) metres from rgb (B, H, W, 3) and sparse (B, H, W) metres; `weights` is unused.
+        Returns (depth, None)."""
+        del weights, return_trajectory
+        _, h, w = sparse.shape
+        x = network_input(rgb, sparse, self.max_depth_m, self.multiple)
+        d = self.module().apply({"params": params}, x)
+        return d[:, :h, :w] * self.max_depth_m, None
 
     def parameter_count(self, params) -> int:
         return parameter_count(params)

@@ -7,7 +7,7 @@ import flax.linen as nn
 import jax
 
 from lipjax.interfaces import register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, group_norm, network_input
+from lipjax.networks.common import NetworkModel, check_max_depth, group_norm
 from lipjax.priors.network import UpProjection
 
 
@@ -100,14 +100,5 @@ class SparseToDense(NetworkModel):
 
     def module(self) -> SparseToDenseNet:
         return SparseToDenseNet(self.width, tuple(self.blocks))
-
-    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
-        """Dense depth (B, H, W) metres from rgb (B, H, W, 3) and sparse (B, H, W) metres; `weights` is unused.
-        Returns (depth, None)."""
-        del weights, return_trajectory
-        _, h, w = sparse.shape
-        x = network_input(rgb, sparse, self.max_depth_m, self.multiple)
-        d = self.module().apply({"params": params}, x)
-        return d[:, :h, :w] * self.max_depth_m, None
 
 

@@ -7,7 +7,7 @@ import flax.linen as nn
 import jax.numpy as jnp
 
 from lipjax.interfaces import register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, depth_to_space2, group_norm, network_input
+from lipjax.networks.common import NetworkModel, check_max_depth, depth_to_space2, group_norm
 
 
 class _DoubleConv(nn.Module):
@@ -88,14 +88,5 @@ class UNet(NetworkModel):
 
     def module(self) -> UNetNet:
         return UNetNet(self.base_width, self.levels)
-
-    def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
-        """Dense depth (B, H, W) metres from rgb (B, H, W, 3) and sparse (B, H, W) metres; `weights` is unused.
-        Returns (depth, None)."""
-        del weights, return_trajectory
-        _, h, w = sparse.shape
-        x = network_input(rgb, sparse, self.max_depth_m, self.multiple)
-        d = self.module().apply({"params": params}, x)
-        return d[:, :h, :w] * self.max_depth_m, None
 
 
