@@ -122,7 +122,8 @@ def _baseline(lip: TrainConfig, name: str, model_type: str, max_depth_m: float) 
 BASELINE_CONFIGS: dict[str, TrainConfig] = {
     f"{key}_{scene}": _baseline(lip, f"{key}-{scene}", model_type, depth)
     for key, model_type in (("ma2018", "sparse_to_dense"), ("unet", "unet"), ("cspn", "cspn"))
-    for scene, lip, depth in (("indoor", LIP_CNN_INDOOR, INDOOR_MAX_DEPTH_M), ("outdoor", LIP_CNN_OUTDOOR, OUTDOOR_MAX_DEPTH_M))
+    for scene, lip, depth in (("indoor", LIP_CNN_INDOOR, INDOOR_MAX_DEPTH_M),
+                              ("outdoor", LIP_CNN_OUTDOOR, OUTDOOR_MAX_DEPTH_M))
 }
 
 # The shared-encoder prox (lipjax.priors.guided): a third of the paper-style G's FLOPs per frame and ~2.7x its
