@@ -2,9 +2,12 @@
 import dataclasses
 import json
 import os
+import pathlib
+import signal
 import subprocess
 import sys
 import textwrap
+import time
 
 import jax
 import numpy as np
@@ -203,3 +206,47 @@ def test_train_command_errors_are_one_line(args, message, capsys):
         train_command.main(args)
     err = capsys.readouterr().err.strip()
     assert exit_.value.code == 2 and message in err and len(err.splitlines()) == 1
+
+
+def _alive(pid: int) -> bool:
+    try:
+        return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _children(pid: int) -> set[int]:
+    """Pids of the live processes whose parent is `pid` (Linux /proc)."""
+    kids = set()
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid and fields[0] != "Z":
+            kids.add(int(stat.parent.name))
+    return kids
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_sigterm_stops_the_loader_workers_with_the_run(tmp_path):
+    """A killed run (SIGTERM) exits with 143 and takes its loader worker process with it; it resumes later."""
+    workdir = tmp_path / "run"
+    cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
+           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=1"]
+    proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.time() + 240
+        while not list((workdir / "checkpoints").glob("[0-9]*")) and time.time() < deadline:
+            time.sleep(0.5)
+        workers = _children(proc.pid)
+        assert workers, "the run should have a loader worker process"
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=60) == 143
+    finally:
+        proc.kill()
+    deadline = time.time() + 20
+    while [w for w in workers if _alive(w)] and time.time() < deadline:
+        time.sleep(0.2)
+    assert not [w for w in workers if _alive(w)], "loader workers outlived the run"

@@ -10,10 +10,13 @@ grain iterator state, and checked on resume.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import pathlib
+import signal
+import threading
 import time
 from typing import Any
 
@@ -68,6 +71,25 @@ def _initial_g_params(config: TrainConfig):
         raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, but this run needs "
                          f"{config.model}; train from scratch with --set init_from=None or pick a matching model")
     return params
+
+
+@contextlib.contextmanager
+def _sigterm_as_exit():
+    """SIGTERM (kill, a scheduler's stop) raises SystemExit(143) in the main thread while training, so that the
+    `finally` blocks run: the loader's worker processes stop with the run instead of outliving it. The last
+    checkpoint is kept; started again, the run resumes from it. No-op outside the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def train(
@@ -127,7 +149,7 @@ def train(
     t_last, images = time.perf_counter(), 0
     step = start
     try:
-        with loader:
+        with _sigterm_as_exit(), loader:
             for step in range(start, end):
                 batch = next(loader)
                 phase = config.phase(step)
