@@ -63,29 +63,37 @@ def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
     return box_fill_with_radius(y, weights)[0]
 
 
+def _or_shifted(a: jax.Array, shift: int, axis: int) -> jax.Array:
+    """a[i - shift] | a[i] | a[i + shift] along `axis` (bool), False outside the image."""
+    n = a.shape[axis]
+    if shift >= n:
+        return a
+    pad = [(0, 0)] * a.ndim
+    pad[axis] = (shift, shift)
+    p = jnp.pad(a, pad)
+    below = jax.lax.slice_in_dim(p, 0, n, axis=axis)
+    above = jax.lax.slice_in_dim(p, 2 * shift, 2 * shift + n, axis=axis)
+    return a | below | above
+
+
 def sample_radius(weights: jax.Array) -> jax.Array:
     """(..., H, W) weights >= 0 -> (..., H, W) float32: `box_fill_with_radius`'s radius map, without the fill.
 
     The same windows and the same rule (the smallest r in 1, 2, 4, ... whose (2r+1)^2 window holds a sample,
-    weight > 1e-6; 0 at a sample), from one summed-area table of the sample count read by slicing for every r,
-    instead of two cumulative sums and gathers per r. Counts are exact in float32 up to 2^24 pixels.
+    weight > 1e-6; 0 at a sample), by dilating the sample mask instead of counting: with D_r the mask dilated
+    by the (2r+1)^2 square, D_2r(i) = D_r(i - r) | D_r(i) | D_r(i + r) along each axis, so every r costs a few
+    shifted boolean reads. The summed-area table this replaces padded the table by r on every side for every r:
+    at 256x320 on the 2-core CPU it took 4.6 ms against 1.8 ms, and in the lip-fast-indoor solver ~10 % of the time.
     """
     h, w = weights.shape[-2:]
-    measured = (weights > 1e-6).astype(jnp.float32)
-    lead = [(0, 0)] * (weights.ndim - 2)
-    table = jnp.pad(jnp.cumsum(jnp.cumsum(measured, axis=-2), axis=-1), lead + [(1, 0), (1, 0)])
+    found = weights > 1e-6  # D_0
     radius_map = jnp.zeros(weights.shape, jnp.float32)
-    found = measured > 0
     radius = 1
     while True:
-        # table[i, j] = count in rows < i, cols < j; edge padding clamps the window to the image
-        t = jnp.pad(table, lead + [(radius, radius), (radius, radius)], mode="edge")
-        hi_r, lo_r = slice(2 * radius + 1, 2 * radius + 1 + h), slice(0, h)
-        hi_c, lo_c = slice(2 * radius + 1, 2 * radius + 1 + w), slice(0, w)
-        count = t[..., hi_r, hi_c] - t[..., lo_r, hi_c] - t[..., hi_r, lo_c] + t[..., lo_r, lo_c]
-        new = ~found & (count > 0.5)
-        radius_map = jnp.where(new, float(radius), radius_map)
-        found = found | new
+        shift = max(radius // 2, 1)  # D_1 from D_0 by 1, then D_r from D_{r/2} by r / 2
+        dilated = _or_shifted(_or_shifted(found, shift, -2), shift, -1)
+        radius_map = jnp.where(dilated & ~found, float(radius), radius_map)
+        found = dilated
         if radius >= max(h, w):
             break
         radius *= 2

@@ -130,12 +130,22 @@ def test_linear_exact_on_a_plane_inside_hull_and_nearest_outside():
     assert out[0, 0] == corner[0, 0] == s[3, 4]  # outside the hull: nearest sample
 
 
-def test_linear_matches_scipy_linearndinterpolator():
-    s = _random_sparse(23, 31, 40, seed=3)
-    out = LinearFill()(_gray(23, 31), s)
+def _grid_sparse(h, w, n, step, seed=0):
+    """Samples on a coarse grid: many pixels lie exactly on triangle edges, and many samples on one line."""
+    rng = np.random.default_rng(seed)
+    s = np.zeros((h, w), np.float32)
+    s[rng.integers(0, h // step, n) * step, rng.integers(0, w // step, n) * step] = rng.uniform(1.0, 5.0, n)
+    return s
+
+
+@pytest.mark.parametrize("s", [_random_sparse(23, 31, 40, seed=3), _grid_sparse(29, 41, 30, 4),
+                               _grid_sparse(40, 33, 60, 3, seed=1)], ids=["random", "grid4", "grid3"])
+def test_linear_matches_scipy_linearndinterpolator(s):
+    """Same values inside the hull, pixels on triangle edges included; the nearest fill outside it."""
+    out = LinearFill()(_gray(*s.shape), s)
     ys, xs = np.nonzero(s)
     ref = interpolate.LinearNDInterpolator(np.stack([ys, xs], 1).astype(float), s[ys, xs].astype(float))(
-        *np.mgrid[0:23, 0:31]
+        *np.mgrid[0:s.shape[0], 0:s.shape[1]]
     )
     inside = ~np.isnan(ref)
     np.testing.assert_allclose(out[inside], ref[inside], atol=1e-5)
