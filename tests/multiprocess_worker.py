@@ -16,7 +16,7 @@ def main(process_id: int, port: int, workdir: str, out: str) -> None:
     sys.path.insert(0, __file__.rsplit("/", 1)[0])
     from test_train import CONFIG, MULTI_PROCESS_STEPS
 
-    from lipjax.checkpoint import to_host
+    from lipjax.train.checkpoint import to_host
     from lipjax.train import loop
 
     assert jax.process_count() == 2 and len(jax.devices()) == 2

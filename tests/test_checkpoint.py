@@ -4,7 +4,7 @@ import jax
 import numpy as np
 import pytest
 
-from lipjax.checkpoint import CheckpointError, CheckpointManager
+from lipjax.train.checkpoint import CheckpointError, CheckpointManager
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 from lipjax.train import loop

@@ -18,7 +18,7 @@ from lipjax.data import pipeline
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 from lipjax.train import loop
-from lipjax.checkpoint import CheckpointManager
+from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import init_state
 

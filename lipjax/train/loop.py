@@ -26,7 +26,7 @@ from jax.sharding import NamedSharding, PartitionSpec
 from tqdm.auto import tqdm
 
 from lipjax import model_io
-from lipjax.checkpoint import CheckpointManager, to_host
+from lipjax.train.checkpoint import CheckpointManager, to_host
 from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader, make_data_mesh, shard_batch
 from lipjax.data.pipeline import validation_batches as source_validation_batches
 from lipjax.data.sample import Batch

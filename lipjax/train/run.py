@@ -11,7 +11,7 @@ import os
 import pathlib
 
 from lipjax import model_io
-from lipjax.checkpoint import CheckpointManager
+from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
 from lipjax.train.loop import evaluate_params, export as export_model, train, validation_batches
