@@ -6,7 +6,8 @@
 
 Without --data-dir it runs on the embedded synthetic outdoor test split at 128x416 (KITTI aspect) with a
 simulated HDL-64E pattern (lipjax.data.sampling.LidarSampler.hdl64). With --data-dir it reads
-depth_selection/val_selection_cropped and uses the real velodyne_raw scans as input (protocol kitti_selection).
+depth_selection/val_selection_cropped (the kitti_selection source of lipjax.data.sources, as training reads data)
+and uses the real velodyne_raw scans as input (protocol kitti_selection).
 Writes results.json, table.md and figure.png into --out (default out/kitti_dc). About 3 minutes by default.
 """
 from __future__ import annotations
@@ -27,6 +28,7 @@ from experiments.common import (
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
+from lipjax.evaluate import open_eval_source
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
 
@@ -60,11 +62,8 @@ def main(argv=None) -> dict:
         config = dataclasses.replace(config, limit=args.limit)
     methods = args.methods.split(",") if args.methods else list(config.methods or available_methods("outdoor"))
     if args.data_dir:
-        from lipjax.data.kitti import KittiLidarInput, KittiSelection
-
-        protocol = get_protocol("kitti_selection")
-        dataset = KittiSelection(args.data_dir)
-        sampler, sampler_name = KittiLidarInput(dataset), "real velodyne_raw"
+        source, protocol = open_eval_source("kitti_selection", args.data_dir, sampler="input")
+        dataset, sampler, sampler_name = source.dataset, source.sampler, "real velodyne_raw"
         data_name = f"KITTI DC val_selection_cropped ({args.data_dir})"
     else:
         protocol = get_protocol("synthetic_outdoor")

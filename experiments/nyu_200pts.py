@@ -18,9 +18,10 @@ import sys
 
 from experiments.common import evaluate_methods, load_methods, parameter_counts, qualitative_figure, write_results
 from lipjax.console import ArgumentParser, positive_int, run_main
-from lipjax.data.protocols import ProtocolView, get_protocol
+from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
+from lipjax.evaluate import open_eval_source
 from lipjax.methods import available_methods
 from lipjax.utils import enable_compilation_cache
 
@@ -68,19 +69,18 @@ def main(argv=None) -> dict:
     if args.train:
         methods = _retrain(out, args.train_steps) + [m for m in methods if not m.startswith(("lip-cnn", "lip-ad"))]
 
-    if args.data_dir:
-        from lipjax.data.nyu import NyuH5Dataset
-
-        protocol = get_protocol(f"nyu_{args.protocol}")
-        dataset = ProtocolView(NyuH5Dataset(args.data_dir, "val"), protocol)
+    sampler_spec = f"uniform:{config.num_points}"
+    if args.data_dir:  # the nyu_h5 source, read as training reads it
+        source, protocol = open_eval_source("nyu_h5", args.data_dir, sampler=sampler_spec,
+                                            protocol=f"nyu_{args.protocol}")
+        dataset, sampler = source.dataset, source.sampler
         data_name = f"NYU Depth v2 val ({args.data_dir})"
     else:
         protocol = get_protocol("synthetic_indoor")
-        dataset = SyntheticDataset("indoor", "test")
+        dataset, sampler = SyntheticDataset("indoor", "test"), sampler_from_spec(sampler_spec)
         data_name = "embedded synthetic indoor test split (lipjax.data.synthetic)"
         print("[lipjax] no --data-dir: NYU Depth v2 is not on this machine, so this runs on the embedded synthetic "
               "indoor test split (256x320). Pass --data-dir to use NYU.", flush=True)
-    sampler = sampler_from_spec(f"uniform:{config.num_points}")
     completers = load_methods(methods)
     results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)

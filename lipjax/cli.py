@@ -6,6 +6,7 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
                     [--uncertainty FILE] [--max-uncertainty M]
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
+    lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
@@ -188,40 +189,60 @@ def _needs_intrinsics(sampler) -> bool:
     return any(isinstance(s, LidarSampler) or (s is not sampler and _needs_intrinsics(s)) for s in inner)
 
 
-def _cmd_evaluate(args) -> int:
+def _data_frames(args, sampler, protocol):
+    """(the frames of --data: the synthetic split or FOLDER, no protocol applied yet; the protocol whose depth
+    range applies, or None)."""
     from lipjax.data import protocols
     from lipjax.data.sample import Intrinsics
-    from lipjax.data.sampling import sampler_from_spec
-    from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json
-    from lipjax.inference import get_completer
 
-    sampler = sampler_from_spec(args.sampler)
-    protocol = protocols.get_protocol(args.protocol) if args.protocol else None
     if args.data in ("synthetic-indoor", "synthetic-outdoor"):
         from lipjax.data.synthetic import SyntheticDataset
 
         kind = args.data.split("-")[1]
         height, width = args.size or (None, None)
         size_kw = {"height": height, "width": width} if args.size else {}
-        dataset = SyntheticDataset(kind, args.split, **size_kw)
-        range_from = protocol or protocols.get_protocol(f"synthetic_{kind}")
-    else:
-        from lipjax.data.folder import FolderDataset
+        return (SyntheticDataset(kind, args.split or "test", **size_kw),
+                protocol or protocols.get_protocol(f"synthetic_{kind}"))
+    from lipjax.data.folder import FolderDataset
 
-        root = Path(args.data)
-        if not root.is_dir():
-            raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
-        intrinsics = _intrinsics_from_args(args)
-        if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
-            if _needs_intrinsics(sampler):
-                raise CLIError(f"--sampler {args.sampler} simulates a LiDAR and needs the camera intrinsics of the "
-                               f"frames in {root}: pass --intrinsics fx fy cx cy or --intrinsics-file F, or write "
-                               f"{root / 'intrinsics.txt'} (fx fy cx cy)")
-            intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # unused: neither this sampler nor the metrics need them
-        dataset = FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics)
-        range_from = protocol
-    if protocol is not None:
-        dataset = protocols.ProtocolView(dataset, protocol)
+    root = Path(args.data)
+    if not root.is_dir():
+        raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
+    intrinsics = _intrinsics_from_args(args)
+    if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
+        if _needs_intrinsics(sampler):
+            raise CLIError(f"--sampler {args.sampler} simulates a LiDAR and needs the camera intrinsics of the "
+                           f"frames in {root}: pass --intrinsics fx fy cx cy or --intrinsics-file F, or write "
+                           f"{root / 'intrinsics.txt'} (fx fy cx cy)")
+        intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # unused: neither this sampler nor the metrics need them
+    return FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics), protocol
+
+
+def _cmd_evaluate(args) -> int:
+    from lipjax.data import protocols
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.sources import NO_PROTOCOL
+    from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, open_eval_source, save_json
+    from lipjax.inference import get_completer
+
+    if args.source is None and (args.root is not None or args.raw_root is not None):
+        raise CLIError("--root and --raw-root go with --source NAME; --data takes the folder itself")
+    if args.source is not None:
+        if args.root is None and args.source != "synthetic":
+            raise CLIError(f"--source {args.source} needs --root DIR, the folder holding the data set")
+        split = args.split or "val"
+        source, range_from = open_eval_source(args.source, args.root, split, sampler=args.sampler,
+                                              protocol=args.protocol, raw_root=args.raw_root,
+                                              depth_scale=args.depth_scale)
+        dataset, sampler = source.dataset, source.sampler  # protocol applied
+        data_name = f"{args.source} {split}" + (f" ({args.root})" if args.root else "")
+    else:
+        protocol = protocols.get_protocol(args.protocol) if args.protocol not in (None, NO_PROTOCOL) else None
+        sampler = sampler_from_spec(args.sampler)
+        dataset, range_from = _data_frames(args, sampler, protocol)
+        if protocol is not None:
+            dataset = protocols.ProtocolView(dataset, protocol)
+        data_name = args.data
     min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
     max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
     if max_depth is None:
@@ -235,7 +256,7 @@ def _cmd_evaluate(args) -> int:
         results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
                                   limit=args.limit, progress=not args.quiet, seed=args.seed)
     n = next(iter(results.values())).num_images
-    print(f"data: {args.data} ({n} frames), sampler: {args.sampler}, depth range: ({min_depth:g}, {max_depth:g}] m")
+    print(f"data: {data_name} ({n} frames), sampler: {args.sampler}, depth range: ({min_depth:g}, {max_depth:g}] m")
     print()
     print(markdown_table(results, columns=columns))
     if args.json:
@@ -316,6 +337,7 @@ def build_parser() -> argparse.ArgumentParser:
     from lipjax import __version__
     from lipjax.data import protocols
     from lipjax.data.folder import OUT_FORMATS
+    from lipjax.data.sources import NO_PROTOCOL, SOURCES
 
     parser = console.ArgumentParser(prog=PROG, description=__doc__,
                                     formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -352,23 +374,33 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--quiet", action="store_true", help="no progress bar or summary")
     c.set_defaults(func=_cmd_complete)
 
-    e = sub.add_parser("evaluate",
-                       help="metrics of model(s) on the synthetic test split or your folder (Markdown table)")
+    e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
+                       "data source (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
                    help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
                         "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
     e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
-    e.add_argument("--data", default="synthetic-indoor",
-                   help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ "
-                        "(lipjax.data.folder layout)")
-    e.add_argument("--split", default="test", choices=("train", "val", "test"), help="synthetic split")
+    data = e.add_mutually_exclusive_group()
+    data.add_argument("--data", default="synthetic-indoor",
+                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ "
+                           "(lipjax.data.folder layout)")
+    data.add_argument("--source", default=None, choices=SOURCES,
+                      help="a training data source, read as training reads it (lipjax.data.sources); its default "
+                           "protocol's crop and depth range unless --protocol says otherwise")
+    e.add_argument("--root", default=None, metavar="DIR", help="the folder of the --source data set")
+    e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
+    e.add_argument("--split", default=None, choices=("train", "val", "test"),
+                   help="synthetic split (default test); with --source train or val (default val)")
     e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="synthetic render size (default 256 320)")
     e.add_argument("--sampler", default="uniform:200",
-                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling)")
-    e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS),
-                   help="named crop/resize + depth range applied to each frame (lipjax.data.protocols)")
-    e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="for PNG ground truth in FOLDER")
+                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling); with --source "
+                        "also input[:N], the data set's own sparse input (KITTI's scan)")
+    e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS) + [NO_PROTOCOL],
+                   help="named crop/resize + depth range applied to each frame (lipjax.data.protocols); none: "
+                        "frames as they are (with --source, still the source's depth range)")
+    e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
+                   help="for PNG ground truth in FOLDER (or --source folder)")
     intr = e.add_mutually_exclusive_group()
     intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"))
     intr.add_argument("--intrinsics-file", default=None, metavar="F")

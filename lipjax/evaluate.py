@@ -3,6 +3,10 @@
     result = evaluate(NearestFill(), dataset, UniformSampler(200), min_depth_m=0.0, max_depth_m=10.0)
     print(markdown_table({"nearest": result}))
 
+    source, protocol = open_eval_source("nyu_h5", "/data/nyudepthv2")   # a training source, read as training does
+    result = evaluate(NearestFill(), source.dataset, source.sampler, min_depth_m=protocol.min_depth_m,
+                      max_depth_m=protocol.max_depth_m)
+
 Protocol, in one place:
   - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
     sample id and this seed, so every method sees the same inputs and reruns are identical;
@@ -28,7 +32,9 @@ from typing import Any
 import numpy as np
 
 from lipjax.classical.completer import DepthCompleter
+from lipjax.data.protocols import Protocol
 from lipjax.data.sample import Sample
+from lipjax.data.sources import Source, open_source, range_protocol
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 
 Sampler = Callable[[Sample, int], np.ndarray]  # (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample
@@ -83,6 +89,38 @@ class EvalResult:
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
+
+
+def open_eval_source(
+    source: str,
+    root: str | os.PathLike | None,
+    split: str = "val",
+    *,
+    sampler: str = "uniform:200",
+    protocol: str | None = None,
+    raw_root: str | os.PathLike | None = None,
+    depth_scale: float | None = None,
+) -> tuple[Source, Protocol | None]:
+    """Every frame of `split` of a training source, read by the code training reads it with
+    (lipjax.data.sources.open_source), and the protocol whose depth range its evaluation uses.
+
+    Args:
+      source, root, raw_root, depth_scale: the data set, as lipjax.train.config.DataConfig names them.
+      split: "val" or "train".
+      sampler: the sparse input, a lipjax.data.sampling spec or "input[:N]" (the data set's own sparse input).
+      protocol: a lipjax.data.protocols name, "none" (frames as they are) or None (the source's default).
+
+    Returns:
+      (Source with the frames and the sampler, the range protocol: lipjax.data.sources.range_protocol; None for
+      a folder, whose range the caller gives). Raises ValueError (DatasetError, naming the expected layout) for a
+      missing or malformed root.
+    """
+    from lipjax.train.config import DataConfig
+
+    data = DataConfig(source=source, root=None if root is None else os.fspath(root),
+                      raw_root=None if raw_root is None else os.fspath(raw_root), protocol=protocol,
+                      depth_scale=depth_scale, train_sampler=sampler, val_sampler=sampler, val_images=None)
+    return open_source(data, split), range_protocol(data)
 
 
 def evaluate(

@@ -77,6 +77,7 @@ def test_convergence_reuses_only_a_finished_k_model_of_the_same_config(tmp_path)
     (kitti_dc, ["--variant", "nope"], 2, "argument --variant: invalid choice: 'nope'"),
     (convergence, ["--variant", "smoke", "--train-k", "x"], 2, "--train-k: expected comma-separated positive integers"),
     (nyu_200pts, ["--variant", "smoke", "--limit", "0"], 2, "--limit: expected a positive integer, got 0"),
+    (nyu_200pts, ["--variant", "smoke", "--data-dir", "{tmp}/no-nyu"], 1, "NYU Depth v2 'val' split not found"),
     (table3, ["--variant", "smoke", "--kitti-odometry-dir", "{tmp}/no-odometry"], 1, "KITTI odometry root not found"),
 ])
 def test_bad_arguments_give_one_line(module, argv, status, message, tmp_path, capsys):

@@ -1,9 +1,9 @@
 """Every training source from tiny fixture files in its real on-disk format: open, train a few steps, resume.
 
-Formats written here: NYU h5 (Ma et al.), KITTI depth completion (annotated + velodyne_raw + raw drive + calib),
-a user folder (rgb/ depth/ sparse/ intrinsics.txt) and `lipjax data render` shards; TFDS nyu_depth_v2 comes from
-tfds.testing.mock_data when tensorflow-datasets is installed. The network is the tiny
-preset with one iteration and every test uses the same crop, so the train step compiles once for the file.
+Formats written here: NYU h5 (Ma et al.), KITTI depth completion (annotated + velodyne_raw + raw drive + calib)
+and its val_selection_cropped, a user folder (rgb/ depth/ sparse/ intrinsics.txt) and `lipjax data render`
+shards; TFDS nyu_depth_v2 comes from tfds.testing.mock_data when tensorflow-datasets is installed. The network is
+the tiny preset with one iteration and every test uses the same crop, so the train step compiles once for the file.
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ import jax
 import numpy as np
 import pytest
 
-from lipjax.checkpoint import CheckpointManager
+from lipjax.train.checkpoint import CheckpointManager
 from lipjax.data.rendered import RenderedDataset, render_to_disk
 from lipjax.data.sources import open_source
 from lipjax.data.synthetic import render
@@ -82,6 +82,19 @@ def make_kitti(root, n=4):
     return root
 
 
+def make_kitti_selection(root, n=2):
+    base = root / "depth_selection" / "val_selection_cropped"
+    for i in range(n):
+        rgb, gt = frame(300 + i, 80.0)
+        stem = f"{DRIVE}_{{}}_{i:010d}_image_02"
+        write_rgb(base / "image" / f"{stem.format('image')}.png", rgb)
+        write_png16(base / "groundtruth_depth" / f"{stem.format('groundtruth_depth')}.png", gt, 256)
+        write_png16(base / "velodyne_raw" / f"{stem.format('velodyne_raw')}.png", np.where(gt > 40, gt, 0), 256)
+        (base / "intrinsics").mkdir(exist_ok=True)
+        (base / "intrinsics" / f"{stem.format('image')}.txt").write_text("40 0 20 0 40 15 0 0 1\n")
+    return root
+
+
 def make_folder(root, n=6):
     for i in range(n):
         rgb, depth = frame(200 + i)
@@ -127,6 +140,14 @@ def test_kitti_input_is_the_real_scan_and_folder_input_its_sparse_maps(tmp_path)
     assert np.array_equal(kitti.sampler(sample), scan.astype(np.float32))
     val = open_source(kitti_config, "val")
     assert np.count_nonzero(val.sampler(val.dataset[0])) == 20
+    selection = dataclasses.replace(kitti_config, source="kitti_selection", root=str(make_kitti_selection(
+        tmp_path / "selection")), val_sampler="input")
+    val = open_source(selection, "val")
+    scan_dir = tmp_path / "selection/depth_selection/val_selection_cropped/velodyne_raw"
+    scan = cv2.imread(str(scan_dir / f"{DRIVE}_velodyne_raw_0000000001_image_02.png"), cv2.IMREAD_UNCHANGED) / 256
+    assert np.array_equal(val.sampler(val.dataset[1]), scan.astype(np.float32)) and scan.any()
+    with pytest.raises(ValueError, match="val split only"):
+        open_source(selection, "train")
     folder = source_config(tmp_path, "folder")
     train, val = open_source(folder, "train"), open_source(folder, "val")
     assert (len(train.dataset), len(val.dataset)) == (5, 1)  # no train/ val/: the last 5 % (>= 1 frame) validates
@@ -230,9 +251,12 @@ def complete(model, rgb, depth, out, *extra):
                           text=True, timeout=600)
 
 
-def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path):
+def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path, capsys):
     """The issue's "done when": the named config on NYU h5 files, exported to a given path, then `lipjax complete`
-    (the fixture frames are 30x40, so the nyu_paper crop is replaced by protocol none)."""
+    and `lipjax evaluate --source nyu_h5` (the fixture frames are 30x40, so the nyu_paper crop is replaced by
+    protocol none)."""
+    from lipjax import cli
+
     root = make_nyu(tmp_path / "nyu")
     model = tmp_path / "model"
     args = ["--config", "lip_cnn_nyu", "--workdir", str(tmp_path / "run"), "--no-progress", "--export", str(model),
@@ -248,6 +272,38 @@ def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path):
     done = complete(model, tmp_path / "rgb.png", tmp_path / "sparse.npy", tmp_path / "out.npy")
     assert done.returncode == 0, done.stderr[-3000:]
     assert np.load(tmp_path / "out.npy").shape == (H, W)
+    assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none", "--model", str(model),
+                     "--limit", "2", "--quiet"]) == 0
+    row = [line for line in capsys.readouterr().out.splitlines() if line.startswith(f"| {model} |")]
+    assert len(row) == 1 and np.isfinite(float(row[0].split("|")[2]))
+
+
+def test_lipjax_evaluate_reads_a_source_as_training_does(tmp_path, capsys):
+    """`lipjax evaluate --source nyu_h5` scores the val frames open_source gives training, over the depth range of
+    the source's protocol (nyu_paper: 10 m) even with protocol none; a missing or bad root is a one-line error."""
+    from lipjax import cli
+    from lipjax.data.protocols import get_protocol
+    from lipjax.evaluate import evaluate
+    from lipjax.inference import get_completer
+
+    root = make_nyu(tmp_path / "nyu")
+    assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none", "--model", "linear",
+                     "--limit", "2", "--quiet", "--json", str(tmp_path / "results.json")]) == 0
+    out = capsys.readouterr().out
+    source = open_source(dataclasses.replace(CONFIG.data, source="nyu_h5", root=str(root), protocol="none",
+                                             val_sampler="uniform:200"), "val")
+    nyu = get_protocol("nyu_paper")
+    want = evaluate(get_completer("linear", None), source.dataset, source.sampler, min_depth_m=nyu.min_depth_m,
+                    max_depth_m=nyu.max_depth_m, limit=2, progress=False)
+    got = json.loads((tmp_path / "results.json").read_text())["linear"]
+    assert np.isfinite(want.metrics["rmse_m"]) and got["metrics"]["rmse_m"] == want.metrics["rmse_m"]
+    assert [r["id"] for r in got["per_image"]] == ["nyu/val/office_0001/1", "nyu/val/office_0001/2"]
+    assert f"| linear | {want.metrics['rmse_m']:.3f} |" in out and "depth range: (0, 10] m" in out
+    for args, message in [(["--root", str(tmp_path / "nowhere")], "lipjax: error: NYU Depth v2 'val' split not found"),
+                          ([], "lipjax: error: --source nyu_h5 needs --root DIR")]:
+        assert cli.main(["evaluate", "--source", "nyu_h5", "--model", "linear", "--quiet", *args]) == 1
+        lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+        assert len(lines) == 1 and lines[0].startswith(message), lines
 
 
 def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):

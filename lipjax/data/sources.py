@@ -6,13 +6,14 @@
     nyu_h5          nyudepthv2/ (Ma et al. h5 layout)      nyu_paper          train / val folders
     nyu_tfds        TFDS data_dir (prepared ArrayRecord)   nyu_paper          train / validation
     kitti_dc        depth_root (raw_root: KITTI raw)       kitti_paper        train / val folders
+    kitti_selection holds depth_selection/                 kitti_selection    val only: val_selection_cropped
     kitti_odometry  holds sequences/                       kitti_paper        last 5 % of each sequence is val
     tartanair       holds the environment folders          tartanair          90 / 5 / 5 by trajectory
     folder          rgb/ depth/ [sparse/], or train/ val/  none               train/ val/ if present, else the
                                                                               last 5 % of the frames is val
 
 Sparse input: a sampler spec of lipjax.data.sampling ("uniform:200", "lidar:hdl64", mixtures "a|b"), or
-"input" / "input:N" for the data set's own sparse input: KITTI DC's real `velodyne_raw` scan, or a folder's
+"input" / "input:N" for the data set's own sparse input: KITTI's real `velodyne_raw` scan, or a folder's
 sparse/<stem> maps (same format and depth scale as depth/); ":N" keeps exactly N of its points.
 
 Depth in metres throughout; `DataConfig` (lipjax.train.config) names the source, its root and the rest.
@@ -27,13 +28,14 @@ from typing import Any
 import numpy as np
 
 from lipjax.data.errors import dataset_error
-from lipjax.data.protocols import ProtocolView, get_protocol
+from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import SparseSampler, example_rng, sampler_from_spec, subsample_exact
 
-SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_odometry", "tartanair", "folder")
+SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_selection", "kitti_odometry", "tartanair",
+           "folder")
 DEFAULT_PROTOCOLS = {"nyu_h5": "nyu_paper", "nyu_tfds": "nyu_paper", "kitti_dc": "kitti_paper",
-                     "kitti_odometry": "kitti_paper", "tartanair": "tartanair"}
+                     "kitti_selection": "kitti_selection", "kitti_odometry": "kitti_paper", "tartanair": "tartanair"}
 VAL_TAIL_FRACTION = 0.05  # sources without a val split hold out the last 5 % of each sequence / folder
 OWN_INPUT = "input"
 NO_PROTOCOL = "none"  # data.protocol="none": frames as they are, even where the source has a default
@@ -150,6 +152,14 @@ def _raw_dataset(data: Any, split: str) -> tuple[Any, Any]:
 
         dataset = KittiDepthCompletion(root, data.raw_root or root, split)
         return dataset, dataset
+    if source == "kitti_selection":
+        from lipjax.data.kitti import KittiSelection
+
+        if split != "val":
+            raise ValueError("data.source='kitti_selection' (depth_selection/val_selection_cropped) is a val split "
+                             "only; train on data.source=kitti_dc")
+        dataset = KittiSelection(root)
+        return dataset, dataset
     if source == "kitti_odometry":
         from lipjax.data.kitti_odometry import KittiOdometry
 
@@ -171,6 +181,24 @@ def _raw_dataset(data: Any, split: str) -> tuple[Any, Any]:
     raise ValueError(f"unknown data.source {source!r}; choose one of {SOURCES}")
 
 
+def applied_protocol(data: Any) -> Protocol | None:
+    """The protocol open_source applies to a DataConfig's frames: data.protocol, else the source's default; None
+    for data.protocol="none" or a source without one."""
+    name = data.protocol or DEFAULT_PROTOCOLS.get(data.source)
+    return get_protocol(name) if name not in (None, NO_PROTOCOL) else None
+
+
+def range_protocol(data: Any) -> Protocol | None:
+    """The protocol whose depth range evaluation on a DataConfig's frames uses: the applied one, else (frames as
+    they are, data.protocol="none") the source's default, synthetic_<data.kind> for the synthetic scenes; None for
+    a folder."""
+    if data.source in ("synthetic", "rendered"):
+        default = f"synthetic_{data.kind}"
+    else:
+        default = DEFAULT_PROTOCOLS.get(data.source)
+    return applied_protocol(data) or (get_protocol(default) if default else None)
+
+
 def open_source(data: Any, split: str) -> Source:
     """The Source of a DataConfig's `split` ("train" or "val"): protocol applied, val cut to val_images frames.
 
@@ -179,14 +207,13 @@ def open_source(data: Any, split: str) -> Source:
     if split not in ("train", "val"):
         raise ValueError(f"split must be 'train' or 'val', got {split!r}")
     dataset, own = _raw_dataset(data, split)
-    protocol_name = data.protocol or DEFAULT_PROTOCOLS.get(data.source)
-    protocol = get_protocol(protocol_name) if protocol_name not in (None, NO_PROTOCOL) else None
+    protocol = applied_protocol(data)
     spec = data.train_sampler if split == "train" else data.val_sampler
     if spec.split(":")[0].strip() == OWN_INPUT:
         if own is None:
             raise ValueError(f"sampler {spec!r}: data.source={data.source!r} has no sparse input of its own; "
                              "use a spec such as uniform:200")
-        if data.source == "kitti_dc":
+        if data.source in ("kitti_dc", "kitti_selection"):
             from lipjax.data.kitti import KittiLidarInput
 
             sampler = KittiLidarInput(own, protocol, _own_points(spec))
@@ -196,7 +223,7 @@ def open_source(data: Any, split: str) -> Source:
         sampler = sampler_from_spec(spec)
     if protocol is not None:
         dataset = ProtocolView(dataset, protocol)
-    if split == "val" and data.source != "synthetic" and len(dataset) > data.val_images:
+    if split == "val" and data.source != "synthetic" and data.val_images is not None and len(dataset) > data.val_images:
         dataset = Subset(dataset, np.arange(data.val_images))
     if len(dataset) == 0:
         raise ValueError(f"data.source={data.source!r} at {data.root}: the {split} split is empty")

@@ -26,6 +26,7 @@ class DataConfig:
     synthetic val split at this size). Training batches are random crops, so that at test time (full size)
     the network sees objects at the same pixel scale and the samples at the same density as in training.
     Samplers: lipjax.data.sampling specs, or "input[:N]" for the data set's own sparse input.
+    val_images: the validation set is the first val_images val frames (None: all of them).
     num_workers: loader worker processes (0: load in the training process).
     augment: training augmentation applied with the crop (zoom, flip, photometric, blur, sample noise).
     """
@@ -36,7 +37,7 @@ class DataConfig:
     crop: tuple[int, int] | None = (128, 160)
     train_sampler: str = "uniform:200"
     val_sampler: str = "uniform:200"
-    val_images: int = 32
+    val_images: int | None = 32
     num_workers: int = 1
     source: str = "synthetic"
     root: str | None = None
