@@ -1,6 +1,7 @@
 """The shared-encoder prox (lipjax.priors.guided): identity at init, scale equivariance, encoder run once."""
 import dataclasses
 
+import flax.linen as nn
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -8,7 +9,8 @@ import pytest
 
 from lipjax import model as lip_model
 from lipjax import model_io
-from lipjax.priors.guided import PRESETS, GuidedPrior, depth_to_space, sample_scale, space_to_depth
+from lipjax.priors.guided import (PRESETS, DepthBranch, GuidanceEncoder, GuidedPrior, depth_to_space, sample_scale,
+                                  space_to_depth)
 
 TINY = PRESETS["tiny"]
 
@@ -36,6 +38,71 @@ def test_space_to_depth_round_trip_and_layout():
     np.testing.assert_array_equal(s[0, 0, 0, :3], a[0, 0, 0])  # top-left pixel of the first 2x2 block
     np.testing.assert_array_equal(s[0, 0, 0, 9:], a[0, 1, 1])  # bottom-right pixel of the same block
     np.testing.assert_array_equal(depth_to_space(s), a)
+
+
+class _ReferenceEncoder(nn.Module):
+    """GuidanceEncoder as first written (nn.Conv + nn.GroupNorm), as the trained weights were fitted."""
+
+    widths: tuple
+
+    @nn.compact
+    def __call__(self, guidance):
+        block = lambda h, c, s=1: nn.relu(nn.GroupNorm(min(8, c))(nn.Conv(c, (3, 3), strides=s)(h)))  # noqa: E731
+        f1 = block(block(space_to_depth(guidance - 0.5), self.widths[0]), self.widths[0])
+        f2 = block(block(f1, self.widths[1], 2), self.widths[1])
+        return f1, f2, block(block(f2, self.widths[2], 2), self.widths[2])
+
+
+class _ReferenceBranch(nn.Module):
+    """DepthBranch as first written: nearest upsampling, concatenation, then the convolution."""
+
+    widths: tuple
+
+    @nn.compact
+    def __call__(self, d, features):
+        block = lambda h, c, s=1: nn.relu(nn.GroupNorm(min(8, c))(nn.Conv(c, (3, 3), strides=s)(h)))  # noqa: E731
+        up = lambda h: jnp.repeat(jnp.repeat(h, 2, axis=1), 2, axis=2)  # noqa: E731
+        (f1, f2, f3), (w1, w2, w3) = features, self.widths
+        h1 = block(jnp.concatenate([space_to_depth(d[..., None]), f1], axis=-1), w1)
+        h2 = block(block(h1, w2, 2) + f2, w2)
+        h3 = block(block(h2, w3, 2) + f3, w3)
+        u2 = block(jnp.concatenate([up(h3), h2], axis=-1), w2)
+        u1 = block(jnp.concatenate([up(u2), h1], axis=-1), w1)
+        return depth_to_space(nn.Conv(4, (3, 3), kernel_init=nn.initializers.zeros)(u1))[..., 0]
+
+
+@pytest.mark.parametrize("widths", [((8, 16, 16), (8, 16, 16)), ((32, 48, 64), (24, 48, 64))], ids=["small", "fast"])
+def test_encoder_and_branch_equal_the_nn_conv_groupnorm_formulation(widths):
+    """Folded GroupNorm bias and upsampling convolutions at low resolution: the same parameter tree (names, shapes
+    and initial values) and the same outputs as nn.Conv + nn.GroupNorm on the upsampled, concatenated maps."""
+    rng = np.random.default_rng(0)
+    g = jnp.asarray(rng.random((2, 24, 40, 5)), jnp.float32)
+    d = jnp.asarray(rng.normal(0, 0.5, (2, 24, 40)), jnp.float32)
+
+    def check(new, ref, *args):
+        params = ref.init(jax.random.key(0), *args)["params"]
+        np.testing.assert_equal(jax.tree_util.tree_map(np.asarray, new.init(jax.random.key(0), *args)["params"]),
+                                jax.tree_util.tree_map(np.asarray, params))
+        params = _scramble(params)  # a non-zero head, non-trivial GroupNorm scales and biases
+        out, expected = new.apply({"params": params}, *args), ref.apply({"params": params}, *args)
+        for a, b in zip(jax.tree_util.tree_leaves(out), jax.tree_util.tree_leaves(expected), strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5 * float(np.abs(b).max()))
+        # and the same gradients, for training (relative to the largest: some are zero up to rounding)
+        def grads(m):
+            def loss(p):
+                return sum((a**2).mean() for a in jax.tree_util.tree_leaves(m.apply({"params": p}, *args)))
+
+            return jax.tree_util.tree_leaves(jax.grad(loss)(params))
+
+        expected = grads(ref)
+        scale = max(float(np.abs(b).max()) for b in expected)
+        for a, b in zip(grads(new), expected, strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-3, atol=1e-5 * scale)
+        return params
+
+    encoder_params = check(GuidanceEncoder(widths[0]), _ReferenceEncoder(widths[0]), g)
+    features = _ReferenceEncoder(widths[0]).apply({"params": encoder_params}, g)
+    check(DepthBranch(widths[1]), _ReferenceBranch(widths[1]), d, features)
 
 
 def test_sample_scale_is_the_geometric_mean_of_the_samples():
@@ -98,7 +165,8 @@ def test_encoder_is_shared_and_runs_once_per_frame():
     total = str(closed).count("conv_general_dilated")
     n_enc = sum(1 for a in jax.tree_util.tree_leaves(params["guidance_encoder"]) if a.ndim == 4)  # conv kernels
     n_branch = sum(1 for a in jax.tree_util.tree_leaves(params["prox"]) if a.ndim == 5)  # (K, kh, kw, in, out)
-    assert in_loop == n_branch  # the loop body holds one depth branch and no encoder
+    # the loop body holds one depth branch and no encoder; its two upsampling layers run as two convolutions each
+    assert in_loop == n_branch + 2
     assert total - in_loop == n_enc  # the encoder runs once, outside the loop
 
 
