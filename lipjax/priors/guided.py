@@ -65,8 +65,8 @@ class _NormParams(nn.Module):
                 self.param("bias", nn.initializers.zeros_init(), (self.features,)))
 
 
-def _conv(h, kernel, strides: int = 1, padding: str = "SAME"):
-    """Convolution without bias, (B, H, W, C_in) -> (B, H', W', C_out), as nn.Conv computes it."""
+def _conv(h, kernel, strides: int = 1, padding="SAME"):
+    """Convolution without bias, (B, H, W, C_in) -> (B, H', W', C_out), as nn.Conv computes it; padding as lax's."""
     return jax.lax.conv_general_dilated(h, kernel, (strides, strides), padding,
                                         dimension_numbers=("NHWC", "HWIO", "NHWC"))
 
@@ -128,8 +128,7 @@ def _upsampled_conv(low, kernel):
     """
     b, h, w, _ = low.shape
     c = kernel.shape[3]
-    y = _conv(jnp.pad(low, ((0, 0), (1, 1), (1, 1), (0, 0))), _upsampled_kernel(kernel), padding="VALID")
-    y = y.reshape(b, h + 1, w + 1, 2, 2, c)
+    y = _conv(low, _upsampled_kernel(kernel), padding=((1, 1), (1, 1))).reshape(b, h + 1, w + 1, 2, 2, c)
     phases = jnp.stack([jnp.stack([y[:, a:a + h, p:p + w, a, p] for p in (0, 1)], axis=3) for a in (0, 1)], axis=2)
     return phases.reshape(b, 2 * h, 2 * w, c)  # (B, h, a, w, b, C) -> (B, 2h, 2w, C)
 
