@@ -44,3 +44,9 @@ def test_sample_radius_equals_the_box_fills_radius(shape, p):
     y = mask * rng.uniform(1, 5, shape).astype(np.float32)
     expected = box_fill_with_radius(jnp.asarray(y), jnp.asarray(mask))[1]
     np.testing.assert_array_equal(sample_radius(jnp.asarray(mask)), expected)
+
+
+def test_sample_radius_without_samples_is_zero_like_the_box_fills():
+    mask = jnp.zeros((2, 9, 13), jnp.float32)
+    np.testing.assert_array_equal(sample_radius(mask), box_fill_with_radius(mask, mask)[1])
+    assert not np.asarray(sample_radius(mask)).any()
