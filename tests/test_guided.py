@@ -105,6 +105,34 @@ def test_encoder_and_branch_equal_the_nn_conv_groupnorm_formulation(widths):
     check(DepthBranch(widths[1]), _ReferenceBranch(widths[1]), d, features)
 
 
+@dataclasses.dataclass(frozen=True)
+class _ReferencePrior(GuidedPrior):
+    def _encoder(self):
+        return _ReferenceEncoder(tuple(self.encoder_widths))
+
+    def _branch(self):
+        return _ReferenceBranch(tuple(self.branch_widths))
+
+
+def test_shipped_model_gives_the_depth_of_the_formulation_it_was_trained_in():
+    """lip-fast-indoor's weights at 256x320: the same depth (within 1e-4 m) as through nn.Conv + nn.GroupNorm."""
+    config, params, _ = model_io.load("lip-fast-indoor")
+    reference = dataclasses.replace(config, prior=_ReferencePrior(**dataclasses.asdict(config.prior)))
+    rng = np.random.default_rng(0)
+    yy, xx = np.mgrid[0:256, 0:320]
+    depth = 2.0 + 0.01 * xx + 0.004 * yy  # a slanted wall with a box in front of it
+    depth[80:180, 100:220] = 1.3
+    rgb = np.clip(40 * depth[..., None] + rng.normal(0, 8, (256, 320, 3)), 0, 255).astype(np.uint8)
+    sparse = np.zeros((1, 256, 320), np.float32)
+    idx = rng.choice(256 * 320, 200, replace=False)
+    sparse.reshape(-1)[idx] = depth.reshape(-1)[idx]
+    z0 = config.host_inputs(sparse)["z0"]
+    out, expected = (np.asarray(jax.jit(lambda p, c=c: c.apply(p, rgb[None], sparse, z0=z0)[0])(params))
+                     for c in (config, reference))
+    np.testing.assert_allclose(out, expected, rtol=0, atol=1e-4)
+    assert np.abs(out - z0).max() > 0.05  # the trained prox does change the fill
+
+
 def test_sample_scale_is_the_geometric_mean_of_the_samples():
     y = jnp.asarray([[[0.0, 2.0], [8.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]])
     s = sample_scale(y, (y > 0).astype(jnp.float32))
