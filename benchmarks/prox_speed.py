@@ -15,7 +15,8 @@ with --models. Columns:
   total ms    `Completer.__call__` end to end (input checks, host fill, solver, copy back): what a user waits;
   frames/s    1000 / total ms.
 The first row is a 2048x2048 float32 matmul (17.2 GFLOP) timed in the same run: divide by its rate to compare
-runs made on machines, or under loads, that differ. Times are medians over --repeats calls after one warm-up.
+runs made on machines, or under loads, that differ; the system's 1-minute load average is printed beside it (above
+the core count, other processes share the cores). Times are medians over --repeats calls after one warm-up.
 """
 from __future__ import annotations
 
@@ -103,7 +104,7 @@ def main(argv=None) -> None:
 
     mm_ms, mm_rate = matmul_rate(args.repeats)
     print(f"{jax.devices()[0].platform} x{os.cpu_count()} cores, {args.height}x{args.width}, batch 1; "
-          f"2048x2048 matmul: {mm_ms:.1f} ms = {mm_rate:.0f} GFLOP/s\n")
+          f"2048x2048 matmul: {mm_ms:.1f} ms = {mm_rate:.0f} GFLOP/s; load average {os.getloadavg()[0]:.1f}\n")
     print("| model | params M | GFLOP | solver ms | fill ms | total ms | frames/s |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for name, completer in completers.items():

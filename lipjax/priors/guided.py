@@ -264,7 +264,7 @@ class GuidedPrior(SharedEncoderPrior):
 
 
 PRESETS: dict[str, GuidedPrior] = {
-    # ~4 GFLOP per 256x320 frame at K = 3 (benchmarks/prox_speed.py), against 18 for the paper-style "small".
+    # 5.9 GFLOP per 256x320 frame at K = 3 (benchmarks/prox_speed.py), against 18 for the paper-style "small".
     "fast": GuidedPrior(),
     # For tests only.
     "tiny": GuidedPrior(encoder_widths=(4, 8, 8), branch_widths=(4, 8, 8)),
