@@ -12,6 +12,7 @@
 3. Train step: images/s of the jitted supervised step of each named config at batch 8 on its training crop
    (compilation not timed), on this machine's JAX backend.
 Everything uses the configs' own samplers and initial fills (lip_cnn_indoor: z0 = linear fill on the host).
+The first line gives the machine's 2048x2048 matmul rate, measured in the same run (benchmarks/prox_speed.py).
 """
 from __future__ import annotations
 
@@ -164,7 +165,10 @@ def main() -> None:
     from lipjax.utils import enable_compilation_cache
 
     enable_compilation_cache()
-    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start")
+    from prox_speed import matmul_rate  # this folder's inference benchmark: the same matmul yardstick
+
+    print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start; 2048x2048 float32 "
+          f"matmul {matmul_rate(10)[1]:.0f} GFLOP/s (divide rates by it to compare machines or loads)")
     base = dataclasses.replace(LIP_CNN_INDOOR.data, crop=CROP)
     print(f"host z0 fill alone, one {CROP[0]}x{CROP[1]} frame, 200 points: linear {fill_ms('linear'):.1f} ms, "
           f"nearest {fill_ms('nearest'):.1f} ms of CPU")
