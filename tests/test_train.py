@@ -250,3 +250,20 @@ def test_sigterm_stops_the_loader_workers_with_the_run(tmp_path):
     while [w for w in workers if _alive(w)] and time.time() < deadline:
         time.sleep(0.2)
     assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
+
+
+def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_path, capsys):
+    """An indoor model fine-tuned outdoors: another depth range and initial fill, the same parameter tree, are
+    accepted (the saved parameters, unchanged); another architecture is a one-line error."""
+    from lipjax import model_io
+
+    params = CONFIG.model.init(jax.random.key(1))
+    model_io.save(tmp_path / "indoor", CONFIG.model, params)
+    outdoor = dataclasses.replace(CONFIG.model, initial_estimate="nearest",
+                                  prior=dataclasses.replace(CONFIG.model.prior, max_depth_m=80.0))
+    got = loop._initial_g_params(dataclasses.replace(CONFIG, model=outdoor, init_from=str(tmp_path / "indoor")))
+    assert _leaves_equal(got, params)
+    assert "['prior', 'initial_estimate']" in capsys.readouterr().out
+    other = dataclasses.replace(CONFIG.model, num_iterations=2)  # one more prox: another parameter tree
+    with pytest.raises(ValueError, match="do not fit"):
+        loop._initial_g_params(dataclasses.replace(CONFIG, model=other, init_from=str(tmp_path / "indoor")))

@@ -11,6 +11,7 @@ grain iterator state, and checked on resume.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -64,12 +65,24 @@ def _to_float(metrics: dict) -> dict:
 
 
 def _initial_g_params(config: TrainConfig):
+    """The parameters of model `config.init_from`. Its config may differ from `config.model` only where the
+    parameters do not (e.g. an indoor model fine-tuned outdoors: another depth range, initial fill); a different
+    parameter tree (names or shapes) is an error."""
     if config.init_from is None:
         return None
     init_config, params, _ = model_io.load(config.init_from)
     if init_config != config.model:
-        raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, but this run needs "
-                         f"{config.model}; train from scratch with --set init_from=None or pick a matching model")
+        def shapes(tree):
+            return jax.tree_util.tree_map(lambda a: tuple(a.shape), tree)
+
+        want = jax.eval_shape(config.model.init, jax.random.key(0))
+        if shapes(want) != shapes(params):
+            raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, whose parameters do "
+                             f"not fit this run's {config.model}; train from scratch with --set init_from=None or "
+                             "pick a model of the same architecture")
+        differ = [f.name for f in dataclasses.fields(config.model)
+                  if getattr(init_config, f.name, None) != getattr(config.model, f.name)]
+        print(f"[lipjax] init_from {config.init_from!r}: its parameters, this run's settings of {differ}")
     return params
 
 
