@@ -7,6 +7,7 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
                     [--uncertainty FILE] [--max-uncertainty M]
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
+    lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
@@ -227,15 +228,36 @@ def _cmd_evaluate(args) -> int:
 
     if args.source is None and (args.root is not None or args.raw_root is not None):
         raise CLIError("--root and --raw-root go with --source NAME; --data takes the folder itself")
+    if args.kind is not None and args.source != "synthetic":
+        raise CLIError(f"--kind goes with --source synthetic; --source rendered reads the kind from the render's "
+                       f"index.json, and --data synthetic-{args.kind} names it itself")
     if args.source is not None:
         if args.root is None and args.source != "synthetic":
             raise CLIError(f"--source {args.source} needs --root DIR, the folder holding the data set")
+        if args.size is not None:
+            raise CLIError(f"--size is for --data synthetic-*; --source {args.source} reads its frames at their "
+                           "own (training) size")
+        if args.intrinsics is not None or args.intrinsics_file is not None:
+            raise CLIError(f"--intrinsics / --intrinsics-file are for --data FOLDER; --source {args.source} reads "
+                           "the data set's own")
+        if args.split not in (None, "train", "val"):
+            raise CLIError(f"--split {args.split}: with --source, the split is train or val")
+        if args.source == "rendered" and args.split is not None:
+            raise CLIError("--split: --source rendered evaluates the frames in --root (their split is the render's); "
+                           "drop --split")
         split = args.split or "val"
         source, range_from = open_eval_source(args.source, args.root, split, sampler=args.sampler,
                                               protocol=args.protocol, raw_root=args.raw_root,
-                                              depth_scale=args.depth_scale)
+                                              depth_scale=args.depth_scale, kind=args.kind)
         dataset, sampler = source.dataset, source.sampler  # protocol applied
-        data_name = f"{args.source} {split}" + (f" ({args.root})" if args.root else "")
+        if args.source == "rendered":
+            from lipjax.data.rendered import RenderedDataset
+
+            render = RenderedDataset(args.root)
+            data_name = f"rendered {render.kind}/{render.split} ({args.root})"
+        else:
+            kind = f" {args.kind or 'indoor'}" if args.source == "synthetic" else ""
+            data_name = f"{args.source}{kind} {split}" + (f" ({args.root})" if args.root else "")
     else:
         protocol = protocols.get_protocol(args.protocol) if args.protocol not in (None, NO_PROTOCOL) else None
         sampler = sampler_from_spec(args.sampler)
@@ -390,7 +412,10 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--root", default=None, metavar="DIR", help="the folder of the --source data set")
     e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", default=None, choices=("train", "val", "test"),
-                   help="synthetic split (default test); with --source train or val (default val)")
+                   help="synthetic split (default test); with --source train or val (default val); --source rendered "
+                        "takes none: it scores the render's frames")
+    e.add_argument("--kind", default=None, choices=("indoor", "outdoor"),
+                   help="the scenes of --source synthetic (default indoor); its depth range follows")
     e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="synthetic render size (default 256 320)")
     e.add_argument("--sampler", default="uniform:200",

@@ -100,27 +100,45 @@ def open_eval_source(
     protocol: str | None = None,
     raw_root: str | os.PathLike | None = None,
     depth_scale: float | None = None,
+    kind: str | None = None,
 ) -> tuple[Source, Protocol | None]:
     """Every frame of `split` of a training source, read by the code training reads it with
     (lipjax.data.sources.open_source), and the protocol whose depth range its evaluation uses.
 
     Args:
       source, root, raw_root, depth_scale: the data set, as lipjax.train.config.DataConfig names them.
-      split: "val" or "train".
+      split: "val" or "train". source="rendered" evaluates the frames in `root` whatever the split (training
+        validates on the synthetic val split instead).
       sampler: the sparse input, a lipjax.data.sampling spec or "input[:N]" (the data set's own sparse input).
       protocol: a lipjax.data.protocols name, "none" (frames as they are) or None (the source's default).
+      kind: "indoor" or "outdoor", the synthetic scenes of source="synthetic" (default indoor), rendered at the
+        kind's training size (lipjax.data.rendered.TRAINING_SIZES). source="rendered" reads its kind from the
+        render's index.json (a different `kind` is an error); other sources take none.
 
     Returns:
-      (Source with the frames and the sampler, the range protocol: lipjax.data.sources.range_protocol; None for
-      a folder, whose range the caller gives). Raises ValueError (DatasetError, naming the expected layout) for a
-      missing or malformed root.
+      (Source with the frames and the sampler, the range protocol: lipjax.data.sources.range_protocol, which is
+      synthetic_<kind> for the synthetic scenes; None for a folder, whose range the caller gives). Raises
+      ValueError (DatasetError, naming the expected layout) for a missing or malformed root.
     """
+    from lipjax.data.rendered import TRAINING_SIZES, RenderedDataset
     from lipjax.train.config import DataConfig
 
+    if source == "rendered" and root is not None:
+        rendered = RenderedDataset(root).kind
+        if kind not in (None, rendered):
+            raise ValueError(f"{root} holds {rendered} renders, not {kind}")
+        kind = rendered
+    elif kind is not None and source != "synthetic":
+        raise ValueError(f"kind={kind!r} is for source 'synthetic' (or 'rendered'), not {source!r}")
+    kind = kind or "indoor"
+    if kind not in TRAINING_SIZES:
+        raise ValueError(f"kind must be 'indoor' or 'outdoor', got {kind!r}")
+    height, width = TRAINING_SIZES[kind]
     data = DataConfig(source=source, root=None if root is None else os.fspath(root),
                       raw_root=None if raw_root is None else os.fspath(raw_root), protocol=protocol,
-                      depth_scale=depth_scale, train_sampler=sampler, val_sampler=sampler, val_images=None)
-    return open_source(data, split), range_protocol(data)
+                      depth_scale=depth_scale, train_sampler=sampler, val_sampler=sampler, val_images=None,
+                      kind=kind, height=height, width=width)
+    return open_source(data, split, render_frames=True), range_protocol(data)
 
 
 def evaluate(

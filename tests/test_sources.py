@@ -329,3 +329,52 @@ def test_lipjax_data_render_command(tmp_path, capsys):
     assert cli.main(args) == 0 and len(RenderedDataset(tmp_path / "r")) == 2
     assert cli.main(args[:5] + ["3"] + args[6:]) == 1  # another render into the same folder: a one-line error
     assert "already holds a different render" in capsys.readouterr().err
+
+
+def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, capsys):
+    """`lipjax evaluate --source rendered --root DIR` scores the frames in DIR (not the synthetic val split) over
+    the depth range of the render's kind (outdoor: 80 m); --kind picks the synthetic scenes of --source synthetic;
+    flags --source ignores, or a split it has not, are one-line errors; training reads a render of another kind
+    as an error for either split."""
+    from lipjax import cli
+    from lipjax.data.protocols import get_protocol
+    from lipjax.evaluate import evaluate, open_eval_source
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.synthetic import sample_id
+    from lipjax.inference import get_completer
+
+    out = render_to_disk("outdoor", "val", 2, tmp_path / "r", height=H, width=W, workers=1, progress=False)
+    assert cli.main(["evaluate", "--source", "rendered", "--root", str(out), "--model", "nearest", "--quiet",
+                     "--json", str(tmp_path / "results.json")]) == 0
+    assert "data: rendered outdoor/val" in capsys.readouterr().out
+    outdoor = get_protocol("synthetic_outdoor")
+    want = evaluate(get_completer("nearest", None), RenderedDataset(out), sampler_from_spec("uniform:200"),
+                    min_depth_m=outdoor.min_depth_m, max_depth_m=outdoor.max_depth_m, progress=False)
+    got = json.loads((tmp_path / "results.json").read_text())["nearest"]
+    assert outdoor.max_depth_m == 80.0 and got["max_depth_m"] == 80.0 and got["num_images"] == 2
+    assert np.isfinite(want.metrics["rmse_m"]) and got["metrics"]["rmse_m"] == want.metrics["rmse_m"]
+    assert [r["id"] for r in got["per_image"]] == [RenderedDataset(out)[i].id for i in range(2)]
+    synthetic, protocol = open_eval_source("synthetic", None, kind="outdoor")
+    first = synthetic.dataset[0]  # the outdoor val split at the outdoor training size
+    assert (first.id, first.shape) == (sample_id("outdoor", "val", 0), (128, 416))
+    assert protocol.name == "synthetic_outdoor"
+    with pytest.raises(ValueError, match="holds outdoor renders"):
+        open_eval_source("rendered", out, kind="indoor")
+    data = dataclasses.replace(CONFIG.data, source="rendered", root=str(out), height=H, width=W)
+    for split in ("train", "val"):
+        with pytest.raises(ValueError, match="add --set data.kind=outdoor"):
+            open_source(data, split)
+    outdoor_val = open_source(dataclasses.replace(data, kind="outdoor"), "val").dataset
+    assert outdoor_val[0].id == render("outdoor", "val", 0, H, W).id and len(outdoor_val) == CONFIG.data.val_images
+    base = ["evaluate", "--model", "nearest", "--quiet"]
+    rendered = ["--source", "rendered", "--root", str(out)]
+    for args, message in [(rendered + ["--size", "16", "24"], "--size is for --data synthetic-*"),
+                          (rendered + ["--intrinsics", "1", "1", "0", "0"], "--intrinsics / --intrinsics-file"),
+                          (["--source", "synthetic", "--intrinsics-file", "K.txt"], "--intrinsics / --intrinsics-file"),
+                          (["--source", "synthetic", "--split", "test"], "--split test: with --source"),
+                          (rendered + ["--split", "val"], "--split: --source rendered evaluates the frames"),
+                          (rendered + ["--kind", "outdoor"], "--kind goes with --source synthetic"),
+                          (["--data", "synthetic-indoor", "--kind", "outdoor"], "--kind goes with --source synthetic")]:
+        assert cli.main(base + args) == 1, args
+        lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+        assert len(lines) == 1 and lines[0].startswith(f"lipjax: error: {message}"), lines

@@ -3,6 +3,7 @@
     source          root                                   default protocol   split
     synthetic       (none: rendered on the fly)            none               the set's own train / val
     rendered        a folder of `lipjax data render`       none               train: the folder; val: synthetic val
+                                                                              of the render's kind
     nyu_h5          nyudepthv2/ (Ma et al. h5 layout)      nyu_paper          train / val folders
     nyu_tfds        TFDS data_dir (prepared ArrayRecord)   nyu_paper          train / validation
     kitti_dc        depth_root (raw_root: KITTI raw)       kitti_paper        train / val folders
@@ -118,7 +119,7 @@ def _folder_root(root: Path, split: str) -> tuple[Path, bool]:
     return root, False
 
 
-def _raw_dataset(data: Any, split: str) -> tuple[Any, Any]:
+def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[Any, Any]:
     """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
     source, root = data.source, data.root
     if source == "synthetic":
@@ -132,12 +133,12 @@ def _raw_dataset(data: Any, split: str) -> tuple[Any, Any]:
         from lipjax.data.rendered import RenderedDataset
         from lipjax.data.synthetic import SyntheticDataset
 
-        if split == "val":  # the fixed on-the-fly val set of the same kind: comparable across runs
-            return SyntheticDataset(data.kind, "val", size=data.val_images, height=data.height, width=data.width), None
-        dataset = RenderedDataset(root)
+        dataset = RenderedDataset(root)  # reads index.json only: the kind check holds for both splits
         if dataset.kind != data.kind:
             raise ValueError(f"{root} holds {dataset.kind} renders but data.kind={data.kind!r}; "
                              f"add --set data.kind={dataset.kind}")
+        if split == "val" and not render_frames:  # the fixed on-the-fly val set of the kind: comparable across runs
+            return SyntheticDataset(data.kind, "val", size=data.val_images, height=data.height, width=data.width), None
         return dataset, None
     if source == "nyu_h5":
         from lipjax.data.nyu import NyuH5Dataset
@@ -199,14 +200,17 @@ def range_protocol(data: Any) -> Protocol | None:
     return applied_protocol(data) or (get_protocol(default) if default else None)
 
 
-def open_source(data: Any, split: str) -> Source:
+def open_source(data: Any, split: str, *, render_frames: bool = False) -> Source:
     """The Source of a DataConfig's `split` ("train" or "val"): protocol applied, val cut to val_images frames.
 
     The train split uses data.train_sampler, val data.val_sampler (see the module docstring for "input").
+    source="rendered": data.kind must be the render's (index.json), for either split; the val split is the
+    synthetic val split of that kind, as training validates, unless render_frames=True (evaluating the render:
+    the folder's frames for either split).
     """
     if split not in ("train", "val"):
         raise ValueError(f"split must be 'train' or 'val', got {split!r}")
-    dataset, own = _raw_dataset(data, split)
+    dataset, own = _raw_dataset(data, split, render_frames)
     protocol = applied_protocol(data)
     spec = data.train_sampler if split == "train" else data.val_sampler
     if spec.split(":")[0].strip() == OWN_INPUT:
