@@ -79,8 +79,8 @@ def sample_radius(weights: jax.Array) -> jax.Array:
     The same windows and the same rule (the smallest r in 1, 2, 4, ... whose (2r+1)^2 window holds a sample,
     weight > 1e-6; 0 at a sample), by dilating the sample mask instead of counting: with D_r the mask dilated
     by the (2r+1)^2 square, D_2r(i) = max(D_r(i - r), D_r(i), D_r(i + r)) along each axis: every r costs two
-    dilated 3-wide windows over a uint8 mask. The summed-area table this replaces padded the table by r on every side
-    for every r: at 256x320 on the 2-core CPU it took 4.5 ms against 0.4 ms, ~10 % of the lip-fast-indoor solver.
+    dilated 3-wide windows over a uint8 mask. The summed-area table this replaces padded the table by r on every
+    side for every r: at 256x320 on the 2-core CPU it took 4.5 ms where this takes 0.4 ms.
     """
     h, w = weights.shape[-2:]
     found = (weights > 1e-6).astype(jnp.uint8)  # D_0
