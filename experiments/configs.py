@@ -129,13 +129,14 @@ BASELINE_CONFIGS: dict[str, TrainConfig] = {
 # The shared-encoder prox (lipjax.priors.guided): a third of the paper-style G's FLOPs per frame and ~2.7x its
 # train-step rate here, so it trains longer for the same CPU time. Started from the linear fill (identity-
 # initialised), L1 loss, zoom / flip / photometric / blur augmentation (lipjax.data.augment.DEFAULT_TRAINING).
-# The shipped lip-fast-indoor (28,000 images; ~75 min wall on the 2-core CPU, shared with other jobs) is this
-# config, trained with
+# The shipped lip-fast-indoor (64,000 images) is this config, trained in two runs on the 2-core CPU:
 #     lipjax data render --kind indoor --split train --count 12000 --out runs/data/indoor-train-256x320
 #     python -m experiments.train --config lip_fast_indoor --set data.source=rendered \
 #         --set data.root=runs/data/indoor-train-256x320 --export lipjax/weights/lip-fast-indoor
-# except for its first 1,000 steps, run at learning rate 1e-3 (cosine over 8,000 steps) with sample noise and
-# outliers on (see DEFAULT_TRAINING); it was resumed at step 1,000 with these settings.
+# (3,500 steps, 28,000 images, ~75 min; its first 1,000 steps at learning rate 1e-3, cosine over 8,000 steps, with
+# sample noise and outliers on, then resumed at step 1,000 with these settings), then continued from those weights
+# for 4,500 steps (36,000 images, ~80 min), validation RMSE 0.198 -> 0.174 m (docs/training/lip-fast-indoor.png):
+#     ... --set init_from=lip-fast-indoor --set g_steps=4500 --set learning_rate=3e-4 --set warmup_steps=200
 LIP_FAST_INDOOR = dataclasses.replace(
     LIP_CNN_INDOOR, name="lip-fast-indoor", model=_fast_model(INDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE),
     data=dataclasses.replace(INDOOR_DATA, augment=DEFAULT_AUGMENT),
