@@ -162,6 +162,12 @@ LIP_AD_FAST_INDOOR = dataclasses.replace(
     learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3,
     discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M, inputs="log_gradients"),
 )
+LIP_AD_FAST_OUTDOOR = dataclasses.replace(
+    LIP_AD_FAST_INDOOR, name="lip-ad-fast-outdoor", model=LIP_FAST_OUTDOOR.model, data=LIP_FAST_OUTDOOR.data,
+    init_from="lip-fast-outdoor", inverse_depth_weight=LIP_FAST_OUTDOOR.inverse_depth_weight,
+    inverse_depth_floor_m=LIP_FAST_OUTDOOR.inverse_depth_floor_m,
+    discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M, inputs="log_gradients"),
+)
 
 # ---- The paper's data sets and your own (lipjax.data.sources). Each run reads its frames from --set data.root=DIR:
 #     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
@@ -251,6 +257,7 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_fast_indoor": LIP_FAST_INDOOR,
     "lip_fast_outdoor": LIP_FAST_OUTDOOR,
     "lip_ad_fast_indoor": LIP_AD_FAST_INDOOR,
+    "lip_ad_fast_outdoor": LIP_AD_FAST_OUTDOOR,
     "smoke": SMOKE,
     **BASELINE_CONFIGS,
     "lip_cnn_nyu": LIP_CNN_NYU,
