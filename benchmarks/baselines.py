@@ -153,8 +153,9 @@ def run_setting(setting: Setting, methods, limit, progress: bool) -> dict:
                                    max_depth_m=setting.depth_range_m[1], limit=limit, progress=progress)
         print(f"  {m.name}: {time.perf_counter() - t0:.1f} s", file=sys.stderr)
     print(markdown_table(results, columns=DEFAULT_COLUMNS), flush=True)
-    if not setting.synthetic and "linear" in results and len(results) > 1:
-        print(per_frame_table(results, "linear"), flush=True)
+    reference = next((name for name in results if name.split("@")[0] == "linear"), None)  # "linear@416" too
+    if not setting.synthetic and reference is not None and len(results) > 1:
+        print(per_frame_table(results, reference), flush=True)
     return results
 
 
