@@ -148,14 +148,14 @@ LIP_FAST_INDOOR = dataclasses.replace(
 # 1,300 steps on 10,000 pre-rendered streets (~50 min here, shared with other jobs):
 #     lipjax data render --kind outdoor --split train --count 10000 --out runs/data/outdoor-train-128x416
 #     python -m experiments.train --config lip_fast_outdoor --set data.source=rendered \
-#         --set data.root=runs/data/outdoor-train-128x416 --set init_from=lip-fast-indoor --set g_steps=1300 \
-#         --set learning_rate=3e-4 --set warmup_steps=100 --export lipjax/weights/lip-fast-outdoor
+#         --set data.root=runs/data/outdoor-train-128x416 --export lipjax/weights/lip-fast-outdoor
 # (validation RMSE 3.81, 3.44, 3.56 m at steps 500, 1,000, 1,300).
 LIP_FAST_OUTDOOR = dataclasses.replace(
     LIP_FAST_INDOOR, name="lip-fast-outdoor", model=_fast_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE),
     data=dataclasses.replace(OUTDOOR_DATA, augment=DEFAULT_AUGMENT),
     inverse_depth_weight=LIP_CNN_OUTDOOR.inverse_depth_weight,
     inverse_depth_floor_m=LIP_CNN_OUTDOOR.inverse_depth_floor_m,
+    init_from="lip-fast-indoor", g_steps=1300, learning_rate=3e-4, warmup_steps=100,
 )
 # LIP+AD on the fast prox: D sees differences of log depth (Discriminator(inputs="log_gradients")): with depth /
 # max_depth, the paper's D stayed at chance (held-out accuracy 0.49-0.50 after 100 steps at lr 2e-4 or 1e-3, and
