@@ -171,6 +171,9 @@ LIP_AD_FAST_INDOOR = dataclasses.replace(
     learning_rate=5e-5, warmup_steps=20, adv_weight=1e-3,
     discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M, inputs="log_gradients"),
 )
+# lip-ad-fast-outdoor is LIP_AD_FAST_OUTDOOR from the shipped lip-fast-outdoor on the rendered streets (--set
+# data.source=rendered --set data.root=runs/data/outdoor-train-128x416; 77,600 images): D accuracy 0.86 after its
+# 100 steps, 0.83 on average over the 300 joint steps; validation RMSE 3.454 / MAE 0.974 m against 3.558 / 1.038.
 LIP_AD_FAST_OUTDOOR = dataclasses.replace(
     LIP_AD_FAST_INDOOR, name="lip-ad-fast-outdoor", model=LIP_FAST_OUTDOOR.model, data=LIP_FAST_OUTDOOR.data,
     init_from="lip-fast-outdoor", inverse_depth_weight=LIP_FAST_OUTDOOR.inverse_depth_weight,
