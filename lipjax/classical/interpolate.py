@@ -18,7 +18,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy import ndimage, spatial
+from scipy import spatial
 
 from lipjax.classical.nearest import nearest_fill
 from lipjax.inputs import check_frame
@@ -93,9 +93,7 @@ def linear_fill(sparse: np.ndarray) -> np.ndarray:
     dense = _rasterise_triangles(points, sparse[ys, xs].astype(np.float64), simplices, sparse.shape)
     outside = np.isnan(dense)
     if outside.any():
-        # nearest_fill's distance transform (so its ties), read only where needed, without the distances
-        iy, ix = ndimage.distance_transform_edt(sparse <= 0, return_distances=False, return_indices=True)
-        dense[outside] = sparse[iy[outside], ix[outside]]
+        dense[outside] = nearest_fill(sparse)[outside]
     return dense.astype(np.float32)
 
 

@@ -20,7 +20,7 @@ def nearest_fill(sparse: np.ndarray) -> np.ndarray:
     """
     # The EDT of the "no sample" mask returns, for each pixel, the index of the nearest zero of that mask,
     # i.e. of the nearest sample.
-    _, (iy, ix) = ndimage.distance_transform_edt(sparse <= 0, return_distances=True, return_indices=True)
+    iy, ix = ndimage.distance_transform_edt(sparse <= 0, return_distances=False, return_indices=True)
     return sparse[iy, ix].astype(np.float32)
 
 
