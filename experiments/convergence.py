@@ -94,7 +94,7 @@ def main(argv=None) -> dict:
     p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", choices=("indoor", "outdoor"), default="indoor")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
-    p.add_argument("--models", help="comma-separated models (default: shipped lip-cnn/lip-ad for the scene)")
+    p.add_argument("--models", help="comma-separated models (default: every shipped LIP model of the scene)")
     p.add_argument("--train-k", type=positive_int_list, help="also train models with these iteration counts, e.g. 1,2,3,5")
     p.add_argument("--train-steps", type=positive_int, default=300)
     p.add_argument("--out", default="out/convergence")
@@ -107,7 +107,7 @@ def main(argv=None) -> dict:
     protocol = get_protocol(f"synthetic_{args.scene}")
     sampler = sampler_from_spec(f"uniform:{config.num_points}")
     models = args.models.split(",") if args.models else [
-        m for m in (f"lip-cnn-{args.scene}", f"lip-ad-{args.scene}") if m in available()]
+        m for m in available() if m.startswith("lip-") and m.endswith(f"-{args.scene}")]
     if not models:
         raise SystemExit("no trained LIP model for this scene: train one (python -m experiments.train) or pass --models")
     curves = {m: mae_per_iteration(load_model(m), dataset, sampler, config.limit, config.seed, protocol.max_depth_m)

@@ -6,6 +6,10 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from lipjax.model import LIPConfig
+from lipjax.priors.guided import sample_scale
+from lipjax.priors.network import network_preset
+from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 from lipjax.train.losses import (
     depth_loss,
@@ -29,6 +33,22 @@ def test_masked_losses_by_hand():
     assert float(masked_mean(pred, jnp.zeros_like(valid))) == 0.0
     with pytest.raises(ValueError, match="'l2' or 'l1'"):
         depth_loss(pred, gt, valid, kind="huber")
+
+
+def test_loss_in_units_of_each_images_sample_scale():
+    """TrainConfig(loss_scale="samples"): errors over the geometric mean s of each image's samples, so a room at
+    2 m and a street at 20 m with the same relative error weigh alike; "max_depth" divides by one constant."""
+    gt = jnp.stack([jnp.full((2, 2), 2.0), jnp.full((2, 2), 20.0)])
+    pred = gt * 1.1
+    sparse = jnp.stack([jnp.array([[1.0, 0.0], [0.0, 4.0]]), jnp.array([[10.0, 0.0], [0.0, 40.0]])])
+    s = sample_scale(sparse, sparse)  # sqrt(1 * 4) = 2 m and sqrt(10 * 40) = 20 m
+    np.testing.assert_allclose(np.asarray(s).ravel(), [2.0, 20.0], rtol=1e-6)
+    per_image = [float(depth_loss(pred[i:i + 1], gt[i:i + 1], gt[i:i + 1] > 0, scale_m=s[i:i + 1])) for i in range(2)]
+    np.testing.assert_allclose(per_image, [0.01, 0.01], rtol=1e-5)  # (0.1 * 2 / 2)^2 = (0.1 * 20 / 20)^2
+    assert float(depth_loss(pred, gt, gt > 0, scale_m=s)) == pytest.approx(0.01, rel=1e-5)
+    assert float(depth_loss(pred, gt, gt > 0, scale_m=10.0)) == pytest.approx((0.04 + 4.0) / 2 / 100, rel=1e-5)
+    with pytest.raises(ValueError, match="loss_scale must be one of"):
+        TrainConfig(name="x", model=LIPConfig(prior=network_preset("tiny")), loss_scale="median")
 
 
 def test_deep_supervision_adds_weighted_iterate_losses():

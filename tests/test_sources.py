@@ -207,6 +207,31 @@ def test_rendered_shards_hold_the_on_the_fly_frames(tmp_path):
     assert window[1].shape == (16, 24) and 0 <= top <= H - 16 and 0 <= left <= W - 24
 
 
+def test_several_rendered_folders_train_as_one_data_set(tmp_path):
+    """data.root="A,B": rooms then streets (one frame size) in one data set, each frame with its own folder's id,
+    intrinsics and depth; data.kind must be the first folder's (it names the val split); other sizes are refused."""
+    rooms = render_to_disk("indoor", "train", 3, tmp_path / "rooms", height=H, width=W, workers=1, progress=False)
+    streets = render_to_disk("outdoor", "train", 2, tmp_path / "streets", height=3 * H, width=4 * W, window=(H, W),
+                             workers=1, progress=False)
+    data = dataclasses.replace(CONFIG.data, source="rendered", root=f"{rooms},{streets}", height=H, width=W)
+    mixed = open_source(data, "train").dataset
+    assert len(mixed) == 5 and mixed.kinds == ("indoor", "outdoor")
+    for i, (part, j) in enumerate([(rooms, 0), (rooms, 1), (rooms, 2), (streets, 0), (streets, 1)]):
+        want, got = RenderedDataset(part)[j], mixed[i]
+        assert got.id == want.id and got.intrinsics == want.intrinsics and np.array_equal(got.depth, want.depth)
+    assert mixed[4].depth.max() > 10.0  # a street, not a room
+    with pytest.raises(IndexError):
+        mixed[5]
+    with pytest.raises(ValueError, match="holds outdoor renders first but data.kind='indoor'"):
+        open_source(dataclasses.replace(data, root=f"{streets},{rooms}"), "train")
+    other = render_to_disk("indoor", "val", 1, tmp_path / "other", height=H + 2, width=W, workers=1, progress=False)
+    with pytest.raises(ValueError, match="different frame sizes"):
+        open_source(dataclasses.replace(data, root=f"{rooms},{other}"), "train")
+    config = dataclasses.replace(CONFIG, name="mixed", data=data, loss_scale="samples")
+    state = loop.train(config, tmp_path / "run", stop_at=2, progress=False)
+    assert int(state.step) == 2
+
+
 @pytest.mark.parametrize("source", ["nyu_h5", "kitti_dc", "folder", "rendered"])
 def test_trains_a_few_steps_and_resumes(tmp_path, source):
     config = dataclasses.replace(CONFIG, name=source, data=source_config(tmp_path, source))

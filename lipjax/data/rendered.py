@@ -227,6 +227,11 @@ class RenderedDataset:
         return self.count
 
     @property
+    def kinds(self) -> tuple[str]:
+        """The kinds of scene in the data set (as RenderedMixture.kinds)."""
+        return (self.kind,)
+
+    @property
     def frame_size(self) -> tuple[int, int]:
         """(h, w) of every stored frame."""
         return self.window or (int(self.index["height"]), int(self.index["width"]))
@@ -265,3 +270,47 @@ class RenderedDataset:
     def __repr__(self) -> str:
         where = os.fspath(self.root)
         return f"RenderedDataset({where!r}: {self.kind}/{self.split}, {self.count} frames {self.frame_size})"
+
+
+class RenderedMixture:
+    """Several rendered folders of one frame size as one data set: their frames one folder after another.
+
+    For training one model on several kinds of scene (rooms and streets), e.g. `data.root=A,B` with
+    `source="rendered"` (lipjax.data.sources). Frames keep their own folder's intrinsics and sample ids.
+
+    Args:
+      parts: the RenderedDatasets, every one with the same frame_size (batches stack frames of one size).
+    """
+
+    def __init__(self, parts: list[RenderedDataset]):
+        sizes = {part.frame_size for part in parts}
+        if len(sizes) != 1:
+            listed = ", ".join(f"{part.root} {part.frame_size[0]}x{part.frame_size[1]}" for part in parts)
+            raise ValueError(f"rendered folders of different frame sizes cannot share batches ({listed}); render them "
+                             "at one size, e.g. `lipjax data render ... --window 256 320`")
+        self.parts = list(parts)
+        self.kinds = tuple(part.kind for part in parts)
+        self.frame_size = sizes.pop()
+        self._ends = np.cumsum([len(part) for part in parts])
+
+    def __len__(self) -> int:
+        return int(self._ends[-1])
+
+    def __getitem__(self, index: int) -> Sample:
+        if not 0 <= int(index) < len(self):
+            raise IndexError(f"index {index} out of range for {len(self)} rendered frames")
+        part = int(np.searchsorted(self._ends, int(index), side="right"))
+        start = int(self._ends[part - 1]) if part else 0
+        return self.parts[part][int(index) - start]
+
+    def __repr__(self) -> str:
+        return f"RenderedMixture({self.parts!r})"
+
+
+def open_rendered(root: str | os.PathLike) -> RenderedDataset | RenderedMixture:
+    """The rendered folder at `root`, or, for a comma-separated list of folders, their RenderedMixture."""
+    roots = [part.strip() for part in os.fspath(root).split(",") if part.strip()]
+    if len(roots) == 1:
+        return RenderedDataset(roots[0])
+    return RenderedMixture([RenderedDataset(r) for r in roots])
+

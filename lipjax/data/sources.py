@@ -2,8 +2,8 @@
 
     source          root                                   default protocol   split
     synthetic       (none: rendered on the fly)            none               the set's own train / val
-    rendered        a folder of `lipjax data render`       none               train: the folder; val: synthetic val
-                                                                              of the render's kind
+    rendered        a folder of `lipjax data render`,      none               train: the folder(s); val: synthetic
+                    or several "A,B" of one frame size                        val of the (first) render's kind
     nyu_h5          nyudepthv2/ (Ma et al. h5 layout)      nyu_paper          train / val folders
     nyu_tfds        TFDS data_dir (prepared ArrayRecord)   nyu_paper          train / validation
     kitti_dc        depth_root (raw_root: KITTI raw)       kitti_paper        train / val folders
@@ -130,13 +130,14 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     if root is None:
         raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")
     if source == "rendered":
-        from lipjax.data.rendered import RenderedDataset
+        from lipjax.data.rendered import open_rendered
         from lipjax.data.synthetic import SyntheticDataset
 
-        dataset = RenderedDataset(root)  # reads index.json only: the kind check holds for both splits
-        if dataset.kind != data.kind:
-            raise ValueError(f"{root} holds {dataset.kind} renders but data.kind={data.kind!r}; "
-                             f"add --set data.kind={dataset.kind}")
+        dataset = open_rendered(root)  # reads index.json only: the kind check holds for both splits
+        first = dataset.kinds[0]
+        if first != data.kind:  # several folders: the first names the val split and the depth range
+            raise ValueError(f"{root} holds {first} renders{' first' if ',' in root else ''} but "
+                             f"data.kind={data.kind!r}; add --set data.kind={first}")
         if split == "val" and not render_frames:  # the fixed on-the-fly val set of the kind: comparable across runs
             return SyntheticDataset(data.kind, "val", size=data.val_images, height=data.height, width=data.width), None
         return dataset, None

@@ -19,7 +19,8 @@ from lipjax.model import LIPConfig
 class DataConfig:
     """Where the frames come from (lipjax.data.sources), the training crop and the sparse samplers.
 
-    source, root: one of lipjax.data.sources.SOURCES and its folder ("synthetic" needs none).
+    source, root: one of lipjax.data.sources.SOURCES and its folder ("synthetic" needs none; "rendered" also
+    takes several folders of one frame size, "A,B", e.g. rooms and streets for one model of both).
     raw_root: KITTI raw drives for source kitti_dc (default: root). protocol: a lipjax.data.protocols name
     (None: the source's default). depth_scale: PNG value per metre of a folder's depth (None: .npy metres).
     kind, height, width: the synthetic scenes (sources synthetic and rendered; rendered validates on the
@@ -47,6 +48,9 @@ class DataConfig:
     augment: Augment = Augment()  # lipjax.data.augment; the default only crops
 
 
+LOSS_SCALES = ("max_depth", "samples")
+
+
 @dataclasses.dataclass(frozen=True)
 class TrainConfig:
     """Everything that defines a training run. Step counts are global optimisation steps."""
@@ -65,6 +69,7 @@ class TrainConfig:
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
     loss: str = "l2"
+    loss_scale: str = "max_depth"  # depth errors in units of: the model's max depth, or "samples" (see __post_init__)
     inverse_depth_weight: float = 0.0  # weight of lipjax.train.losses.inverse_depth_loss (1/m) added to the depth loss
     inverse_depth_floor_m: float = 1.0
     iteration_weights: tuple[float, ...] = ()
@@ -75,6 +80,13 @@ class TrainConfig:
     keep_checkpoints: int = 3
     seed: int = 0
     init_from: str | None = None
+
+    def __post_init__(self):
+        # "max_depth": errors / the prior's max depth (one constant per model); "samples": errors / each frame's
+        # own sample scale s (geometric mean of its sparse depths, lipjax.priors.guided.sample_scale), so rooms
+        # at 3 m and streets at 20 m weigh alike when one model trains on both.
+        if self.loss_scale not in LOSS_SCALES:
+            raise ValueError(f"loss_scale must be one of {LOSS_SCALES}, got {self.loss_scale!r}")
 
     @property
     def total_steps(self) -> int:

@@ -16,7 +16,8 @@ def masked_mean(values: jax.Array, mask: jax.Array) -> jax.Array:
 
 def depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, kind: str = "l2",
                scale_m: float = 1.0) -> jax.Array:
-    """Masked L2 (mean squared) or L1 (mean absolute) error of (B, H, W) depths, in units of scale_m."""
+    """Masked L2 (mean squared) or L1 (mean absolute) error of (B, H, W) depths, in units of scale_m (metres: a
+    number, or a (B, 1, 1) array with one unit per image)."""
     err = (pred - gt) / scale_m
     if kind == "l2":
         return masked_mean(err**2, valid)

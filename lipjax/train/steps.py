@@ -15,6 +15,7 @@ import jax
 import jax.numpy as jnp
 import optax
 
+from lipjax.priors.guided import sample_scale
 from lipjax.train.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import TrainState, make_optimizers
@@ -55,7 +56,8 @@ def _make_steps(config: TrainConfig) -> Steps:
 
     def g_supervised(g_params, batch):
         out, iterates = g_forward(g_params, batch)
-        loss = supervised_loss(out, iterates, batch["gt"], batch["gt_valid"], kind=config.loss, scale_m=scale,
+        unit = scale if config.loss_scale == "max_depth" else sample_scale(batch["sparse"], batch["sparse"])
+        loss = supervised_loss(out, iterates, batch["gt"], batch["gt_valid"], kind=config.loss, scale_m=unit,
                                iteration_weights=config.iteration_weights,
                                inverse_depth_weight=config.inverse_depth_weight,
                                inverse_depth_floor_m=config.inverse_depth_floor_m)
