@@ -110,18 +110,25 @@ def config_fields(config) -> dict[str, Any]:
 
 
 def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequence[float]], *, xlabel: str,
-              ylabel: str, title: str = "", logx: bool = False) -> None:
-    """One line per method (the paper's Fig. 4 style), written as PNG."""
+              ylabel: str, title: str = "", logx: bool = False, logy: bool = False) -> None:
+    """One line per method (the paper's Fig. 4 style), written as PNG. logy: for errors that span orders of
+    magnitude across methods (e.g. a KITTI-tuned fill failing on scattered points next to the LIP models)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(5.5, 3.8), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
+    if len(series) > 10:  # the default cycle has 10 colours: no two methods may share one
+        from matplotlib import colormaps
+
+        ax.set_prop_cycle(color=colormaps["tab20"].colors)
     for name, ys in series.items():
         ax.plot(xs, ys, marker="o", label=name, linestyle="--" if "wavelet" in name else "-")
     if logx:
         ax.set_xscale("log")
+    if logy:
+        ax.set_yscale("log")
     ax.set_xticks(list(xs), [f"{x:g}" for x in xs])  # the measured points only (no 1.5 iterations, no 10^3 ticks)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)

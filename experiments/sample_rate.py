@@ -35,6 +35,15 @@ class Config:
 VARIANTS = {"default": Config(), "smoke": Config(point_counts=(50, 200), limit=1, methods=("nearest", "linear"))}
 
 
+def plot_curves(table: dict[str, dict[int, dict[str, float]]], xs: list[int], out: pathlib.Path, title: str) -> None:
+    """mae_all.png (log scale: the methods' errors span orders of magnitude) and mae_sampled.png (linear: it
+    holds zeros) from the table of main (method -> N -> metric)."""
+    for key, fname, label, logy in (("mae_all_m", "mae_all.png", "MAE over all pixels (m)", True),
+                                    ("mae_sampled_m", "mae_sampled.png", "MAE on sampled pixels (m)", False)):
+        line_plot(out / fname, xs, {m: [table[m][n][key] for n in xs] for m in table}, xlabel="number of samples",
+                  ylabel=label, title=title, logx=True, logy=logy)
+
+
 def main(argv=None) -> dict:
     p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--scene", choices=("indoor", "outdoor"), default="indoor")
@@ -55,10 +64,7 @@ def main(argv=None) -> dict:
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     xs = list(config.point_counts)
-    for key, fname, label in (("mae_all_m", "mae_all.png", "MAE over all pixels (m)"),
-                              ("mae_sampled_m", "mae_sampled.png", "MAE on sampled pixels (m)")):
-        line_plot(out / fname, xs, {m: [table[m][n][key] for n in xs] for m in methods}, xlabel="number of samples",
-                  ylabel=label, title=f"synthetic {args.scene} test, {config.limit} images", logx=True)
+    plot_curves(table, xs, out, title=f"synthetic {args.scene} test, {config.limit} images")
     (out / "results.json").write_text(json.dumps({"meta": dataclasses.asdict(config) | {"scene": args.scene},
                                                   "methods": table}, indent=1))
     lines = ["| method | " + " | ".join(f"N={n} all / sampled" for n in xs) + " |", "|---|" + "---:|" * len(xs)]

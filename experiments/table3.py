@@ -50,7 +50,8 @@ def plot_blocks(doc: dict, point_counts, out: pathlib.Path) -> list[pathlib.Path
         per_n = [doc["blocks"][f"{block}, {n} points"] for n in point_counts]
         series = {m: [rows[m]["rmse_m"] for rows in per_n] for m in per_n[0]}
         paths.append(out / f"table3_block{i}.png")
-        line_plot(paths[-1], list(point_counts), series, xlabel="number of samples", ylabel="RMSE (m)", title=block)
+        line_plot(paths[-1], list(point_counts), series, xlabel="number of samples", ylabel="RMSE (m)", title=block,
+                  logy=True)
     return paths
 
 
