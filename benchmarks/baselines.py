@@ -108,7 +108,8 @@ def load_middlebury(root: str) -> list[Sample]:
     with np.errstate(divide="ignore", invalid="ignore"):
         depth_m = np.where(np.isfinite(disp), baseline_mm * f / (disp + doffs) / 1000.0, 0.0)
     rgb = _rgb(os.path.join(root, "im0.png"))
-    return [Sample.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy), "realdata/middlebury/motorcycle")]
+    return [Sample.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy),
+                              "realdata/middlebury/motorcycle")]
 
 
 # ------------------------------------------------------------------------------------------- runner
@@ -126,7 +127,8 @@ class Setting:
 @dataclasses.dataclass
 class Downsized:
     """A method run on the frame downsized to `max_side` (longer side), upsampled back with the measured pixels
-    re-imposed (lipjax.inference.complete_frame): e.g. real KITTI frames at the scale of the outdoor training renders."""
+    re-imposed (lipjax.inference.complete_frame): e.g. real KITTI frames at the scale of the outdoor training
+    renders."""
 
     method: object
     max_side: int
@@ -213,12 +215,18 @@ def main(argv=None) -> None:
         kitti = [protocols.KITTI_PAPER(s) for s in load_kitti(os.path.join(root, "kitti"))]
         mb = load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
         settings += [
-            Setting("real NYU v2 (3 frames, nyu_paper 256x320), 200 uniform points", nyu, UniformSampler(200), INDOOR_RANGE_M),
-            Setting("real KITTI (3 frames, kitti_paper 256x1216), HDL-64 pattern on GT", kitti, LidarSampler.hdl64(), OUTDOOR_RANGE_M),
-            Setting("real KITTI (3 frames, kitti_paper 256x1216), VLP-16 pattern on GT", kitti, LidarSampler.vlp16(), OUTDOOR_RANGE_M),
-            Setting("real KITTI (3 frames, kitti_paper 256x1216), 200 uniform points", kitti, UniformSampler(200), OUTDOOR_RANGE_M),
-            Setting("real Middlebury 2014 Motorcycle (1 frame, 497x741), 200 uniform points", mb, UniformSampler(200), INDOOR_RANGE_M),
-            Setting("real Middlebury 2014 Motorcycle (1 frame, 497x741), 500 uniform points", mb, UniformSampler(500), INDOOR_RANGE_M),
+            Setting("real NYU v2 (3 frames, nyu_paper 256x320), 200 uniform points", nyu, UniformSampler(200),
+                    INDOOR_RANGE_M),
+            Setting("real KITTI (3 frames, kitti_paper 256x1216), HDL-64 pattern on GT", kitti, LidarSampler.hdl64(),
+                    OUTDOOR_RANGE_M),
+            Setting("real KITTI (3 frames, kitti_paper 256x1216), VLP-16 pattern on GT", kitti, LidarSampler.vlp16(),
+                    OUTDOOR_RANGE_M),
+            Setting("real KITTI (3 frames, kitti_paper 256x1216), 200 uniform points", kitti, UniformSampler(200),
+                    OUTDOOR_RANGE_M),
+            Setting("real Middlebury 2014 Motorcycle (1 frame, 497x741), 200 uniform points", mb, UniformSampler(200),
+                    INDOOR_RANGE_M),
+            Setting("real Middlebury 2014 Motorcycle (1 frame, 497x741), 500 uniform points", mb, UniformSampler(500),
+                    INDOOR_RANGE_M),
         ]
     elif not args.skip_real:
         print(f"\n(no real data at {root}: skipped)")

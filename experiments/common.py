@@ -47,7 +47,8 @@ def parameter_counts(completers: dict[str, Any]) -> dict[str, int | None]:
 
 def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],
                   columns: Sequence[str], extra_columns: dict[str, dict[str, Any]] | None = None) -> str:
-    """Writes out/results.json (aggregated metrics with units in the keys + meta) and out/table.md; returns the table."""
+    """Writes out/results.json (aggregated metrics with units in the keys + meta) and out/table.md; returns the
+    table."""
     out.mkdir(parents=True, exist_ok=True)
     doc = {
         "meta": {**meta, "hardware": f"{platform.machine()} {platform.processor() or ''}".strip(),

@@ -95,7 +95,8 @@ def main(argv=None) -> dict:
     p.add_argument("--scene", choices=("indoor", "outdoor"), default="indoor")
     p.add_argument("--variant", choices=sorted(VARIANTS), default="default")
     p.add_argument("--models", help="comma-separated models (default: every shipped LIP model of the scene)")
-    p.add_argument("--train-k", type=positive_int_list, help="also train models with these iteration counts, e.g. 1,2,3,5")
+    p.add_argument("--train-k", type=positive_int_list,
+                   help="also train models with these iteration counts, e.g. 1,2,3,5")
     p.add_argument("--train-steps", type=positive_int, default=300)
     p.add_argument("--out", default="out/convergence")
     args = p.parse_args(argv)
@@ -109,7 +110,8 @@ def main(argv=None) -> dict:
     models = args.models.split(",") if args.models else [
         m for m in available() if m.startswith("lip-") and m.endswith(f"-{args.scene}")]
     if not models:
-        raise SystemExit("no trained LIP model for this scene: train one (python -m experiments.train) or pass --models")
+        raise SystemExit("no trained LIP model for this scene: train one (python -m experiments.train) "
+                         "or pass --models")
     curves = {m: mae_per_iteration(load_model(m), dataset, sampler, config.limit, config.seed, protocol.max_depth_m)
               for m in models}
     doc = {"meta": {**dataclasses.asdict(config), "scene": args.scene,
@@ -131,7 +133,8 @@ def main(argv=None) -> dict:
     longest = max(len(c) for c in curves.values())
     line_plot(out / "convergence.png", list(range(longest)),
               {m: c + [np.nan] * (longest - len(c)) for m, c in curves.items()},
-              xlabel="prox steps applied", ylabel="MAE (m)", title=f"synthetic {args.scene} test, {config.num_points} points")
+              xlabel="prox steps applied", ylabel="MAE (m)",
+              title=f"synthetic {args.scene} test, {config.num_points} points")
     (out / "results.json").write_text(json.dumps(doc, indent=1))
     (out / "table.md").write_text("MAE (m) after each iteration\n\n" + "\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -82,7 +82,8 @@ def main(argv=None) -> dict:
             "dataset": data_name, "protocol": protocol.name, "sampler": sampler_name, "seed": config.seed,
             "num_images": n, "variant": args.variant}
     out = pathlib.Path(args.out)
-    table = write_results(out, results, meta, COLUMNS, {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
+    table = write_results(out, results, meta, COLUMNS,
+                          {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
     frames = [dataset[i] for i in range(2 if args.variant != "smoke" else 1)]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers,
                        max_depth_m=protocol.max_depth_m, max_error_m=5.0)

@@ -56,7 +56,8 @@ def main(argv=None) -> dict:
     p.add_argument("--methods", help="comma-separated method names (default: all available)")
     p.add_argument("--limit", type=positive_int, help="evaluate only the first N frames")
     p.add_argument("--train", action="store_true", help="retrain LIP+CNN and LIP+AD first (see --train-steps)")
-    p.add_argument("--train-steps", type=positive_int, default=200, help="G steps for LIP+CNN and adversarial steps for LIP+AD")
+    p.add_argument("--train-steps", type=positive_int, default=200,
+                   help="G steps for LIP+CNN and adversarial steps for LIP+AD")
     p.add_argument("--out", default="out/nyu_200pts")
     args = p.parse_args(argv)
     enable_compilation_cache()
@@ -93,7 +94,8 @@ def main(argv=None) -> dict:
         "dataset": data_name, "protocol": protocol.name, "sampler": f"uniform:{config.num_points}",
         "seed": config.seed, "num_images": next(iter(results.values())).num_images, "variant": args.variant,
     }
-    table = write_results(out, results, meta, COLUMNS, {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
+    table = write_results(out, results, meta, COLUMNS,
+                          {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
     frames = [dataset[i] for i in range(min(config.figure_frames, len(dataset)))]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers,
                        max_depth_m=protocol.max_depth_m, max_error_m=0.5)
@@ -107,8 +109,8 @@ def _retrain(out: pathlib.Path, steps: int) -> list[str]:
     from experiments import train
 
     cnn, ad = out / "models/lip-cnn-indoor", out / "models/lip-ad-indoor"
-    train.main(["--config", "lip_cnn_indoor", "--workdir", str(out / "runs/lip_cnn_indoor"), "--set", f"g_steps={steps}",
-                "--export", str(cnn)])
+    train.main(["--config", "lip_cnn_indoor", "--workdir", str(out / "runs/lip_cnn_indoor"),
+                "--set", f"g_steps={steps}", "--export", str(cnn)])
     train.main(["--config", "lip_ad_indoor", "--workdir", str(out / "runs/lip_ad_indoor"), "--set", f"init_from={cnn}",
                 "--set", f"d_steps={max(1, steps // 5)}", "--set", f"adv_steps={steps}", "--export", str(ad)])
     return [str(cnn), str(ad)]

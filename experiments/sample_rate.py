@@ -57,8 +57,9 @@ def main(argv=None) -> dict:
     methods = list(config.methods or available_methods(args.scene))
     table: dict[str, dict[int, dict[str, float]]] = {m: {} for m in methods}
     for n in config.point_counts:
-        results = evaluate_methods(methods, dataset, sampler_from_spec(f"uniform:{n}"), min_depth_m=protocol.min_depth_m,
-                                   max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
+        results = evaluate_methods(methods, dataset, sampler_from_spec(f"uniform:{n}"),
+                                   min_depth_m=protocol.min_depth_m, max_depth_m=protocol.max_depth_m,
+                                   limit=config.limit, seed=config.seed)
         for m, r in results.items():
             table[m][n] = {"mae_all_m": r.metrics["mae_all_m"], "mae_sampled_m": r.metrics["mae_sampled_m"]}
     out = pathlib.Path(args.out)

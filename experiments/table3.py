@@ -72,14 +72,17 @@ def main(argv=None) -> dict:
         odometry = ProtocolView(KittiOdometry(args.kitti_odometry_dir, tuple(args.sequences.split(","))), protocol)
         blocks = {"KITTI odometry": ("outdoor", odometry, protocol)}
     else:
-        blocks = {"outdoor (KITTI odometry stand-in)": ("outdoor", synthetic_outdoor_test(), get_protocol("synthetic_outdoor"))}
+        blocks = {"outdoor (KITTI odometry stand-in)": ("outdoor", synthetic_outdoor_test(),
+                                                        get_protocol("synthetic_outdoor"))}
     if args.tartanair_dir:
         from lipjax.data.tartanair import TartanAirDataset
 
         protocol = get_protocol("tartanair")
-        blocks["TartanAir test"] = ("indoor", ProtocolView(TartanAirDataset(args.tartanair_dir, "test"), protocol), protocol)
+        blocks["TartanAir test"] = ("indoor", ProtocolView(TartanAirDataset(args.tartanair_dir, "test"), protocol),
+                                    protocol)
     else:
-        blocks["indoor (TartanAir stand-in)"] = ("indoor", SyntheticDataset("indoor", "test"), get_protocol("synthetic_indoor"))
+        blocks["indoor (TartanAir stand-in)"] = ("indoor", SyntheticDataset("indoor", "test"),
+                                                 get_protocol("synthetic_indoor"))
         print("[lipjax] no --tartanair-dir: the TartanAir block runs on the embedded synthetic indoor test split.")
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -87,8 +90,9 @@ def main(argv=None) -> dict:
     for block, (scene, dataset, protocol) in blocks.items():
         methods = list(config.methods or available_methods(scene))
         for n in config.point_counts:
-            results = evaluate_methods(methods, dataset, sampler_from_spec(f"uniform:{n}"), min_depth_m=protocol.min_depth_m,
-                                       max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
+            results = evaluate_methods(methods, dataset, sampler_from_spec(f"uniform:{n}"),
+                                       min_depth_m=protocol.min_depth_m, max_depth_m=protocol.max_depth_m,
+                                       limit=config.limit, seed=config.seed)
             key = f"{block}, {n} points"
             doc["blocks"][key] = {m: {**r.metrics, "num_images": r.num_images, "sampler": f"uniform:{n}",
                                       "protocol": protocol.name} for m, r in results.items()}

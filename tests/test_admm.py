@@ -132,7 +132,8 @@ def test_exact_quadratic_prox_converges_to_closed_form_solution():
 
 
 def test_gradients_flow_to_every_iterations_network():
-    config = lip_model.LIPConfig(prior=network_preset("tiny"), num_iterations=3, initial_estimate="box_fill")  # rho_0 matters only with a fill
+    # rho_0 matters only with a fill
+    config = lip_model.LIPConfig(prior=network_preset("tiny"), num_iterations=3, initial_estimate="box_fill")
     params = lip_model.init(config, jax.random.key(0))
     # The zero-initialised residual heads block gradients to the layers below them at init; give them small
     # random weights so every layer of every iteration is reachable.

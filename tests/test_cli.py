@@ -68,7 +68,8 @@ def frame(tmp_path_factory):
 
 
 def _complete(model, frame, out, *extra, depth="npy"):
-    args = ["complete", "--rgb", frame["rgb"], "--depth", frame[depth], "--model", model[0], "--out", str(out), "--quiet"]
+    args = ["complete", "--rgb", frame["rgb"], "--depth", frame[depth], "--model", model[0], "--out", str(out),
+            "--quiet"]
     if depth == "png":
         args += ["--depth-scale", "256"]
     return cli.main(args + list(extra))
@@ -107,8 +108,8 @@ def test_folder_batch_pairs_frames_by_trailing_number(model, tmp_path):
     for i, (rgb, sparse) in frames.items():  # BTS-style NYU names: stems differ, numbers match
         cv2.imwrite(str(tmp_path / "rgb" / f"rgb_{i:05d}.png"), rgb[..., ::-1])
         cv2.imwrite(str(tmp_path / "depth" / f"sync_depth_{i:05d}.png"), np.round(sparse * SCALE).astype(np.uint16))
-    rc = cli.main(["complete", "--rgb", str(tmp_path / "rgb"), "--depth", str(tmp_path / "depth"), "--depth-scale", "kitti",
-                   "--model", model[0], "--out", str(tmp_path / "out"), "--out-format", "npy"])
+    rc = cli.main(["complete", "--rgb", str(tmp_path / "rgb"), "--depth", str(tmp_path / "depth"), "--depth-scale",
+                   "kitti", "--model", model[0], "--out", str(tmp_path / "out"), "--out-format", "npy"])
     assert rc == 0
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["rgb_00002.npy", "rgb_00010.npy"]
     for i, (rgb, sparse) in frames.items():
@@ -133,7 +134,8 @@ def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, t
     ("too_many_iterations", "this model has 1 iterations"),
     ("ply_without_intrinsics", "intrinsics"),
     ("zero_intrinsics", "intrinsics fx=0 fy=0 cx=0 cy=0: the focal lengths fx, fy must be > 0"),
-    ("model_files_mismatch", "bad.msgpack does not match bad.json (the config makes parameters ['log_rho', 'prox'], the file holds ['encoder'])"),
+    ("model_files_mismatch", "bad.msgpack does not match bad.json (the config makes parameters ['log_rho', 'prox'], "
+                             "the file holds ['encoder'])"),
     ("model_json_bad_field", "bad.json: not a valid lipjax model config (TypeError: "),
     ("model_file_truncated", "bad.msgpack: cannot read the parameters, the file is damaged or truncated"),
 ])
@@ -274,7 +276,8 @@ def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
 def test_export_command_writes_a_deserializable_file(model, tmp_path):
     pytest.importorskip("flatbuffers")
     out = tmp_path / "m.stablehlo"
-    rc = cli.main(["export", "--model", model[0], "--height", "8", "--width", "16", "--batch", "2", "--out", str(out), "--quiet"])
+    rc = cli.main(["export", "--model", model[0], "--height", "8", "--width", "16", "--batch", "2", "--out", str(out),
+                   "--quiet"])
     assert rc == 0
     exported = jax.export.deserialize(bytearray(out.read_bytes()))
     assert [a.shape for a in exported.in_avals] == [(2, 8, 16, 3), (2, 8, 16)]

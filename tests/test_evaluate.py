@@ -52,7 +52,8 @@ def test_evaluate_aggregates_per_image_metrics():
     expected = []
     for s in data:
         sparse = _sampler(s, 0)
-        expected.append(compute_metrics(NearestFill()(s.rgb, sparse), s.depth, s.valid, sparse, min_depth_m=0.0, max_depth_m=2.5))
+        expected.append(compute_metrics(NearestFill()(s.rgb, sparse), s.depth, s.valid, sparse, min_depth_m=0.0,
+                                        max_depth_m=2.5))
     for k in ("mae_m", "rmse_m", "delta1_pct", "mae_unsampled_m"):
         vals = [e[k] for e in expected if not math.isnan(e[k])]
         assert res.metrics[k] == pytest.approx(np.mean(vals))

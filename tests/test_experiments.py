@@ -73,7 +73,8 @@ def test_convergence_reuses_only_a_finished_k_model_of_the_same_config(tmp_path)
 
 
 @pytest.mark.parametrize("module, argv, status, message", [
-    (kitti_dc, ["--variant", "smoke", "--data-dir", "{tmp}/no-kitti"], 1, "KITTI val_selection_cropped/image not found"),
+    (kitti_dc, ["--variant", "smoke", "--data-dir", "{tmp}/no-kitti"], 1,
+     "KITTI val_selection_cropped/image not found"),
     (kitti_dc, ["--variant", "nope"], 2, "argument --variant: invalid choice: 'nope'"),
     (convergence, ["--variant", "smoke", "--train-k", "x"], 2, "--train-k: expected comma-separated positive integers"),
     (nyu_200pts, ["--variant", "smoke", "--limit", "0"], 2, "--limit: expected a positive integer, got 0"),

@@ -71,7 +71,8 @@ def test_exported_file_runs_with_jax_only(exported_file, tmp_path):
     """)
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
     assert result.returncode == 0, result.stderr[-2000:]
-    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), load_exported(exported_file)(rgb, sparse), rtol=1e-6, atol=1e-6)
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), load_exported(exported_file)(rgb, sparse),
+                               rtol=1e-6, atol=1e-6)
 
 
 def test_wrong_input_shape_or_file_is_a_clear_error(exported_file, tmp_path):

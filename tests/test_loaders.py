@@ -95,7 +95,8 @@ def test_nyu_h5_values_ids_order(tmp_path):
     written = {n: write_nyu_h5(root / "val" / "official" / f"{n}.h5", n) for n in (10, 2, 1)}
     write_nyu_h5(root / "val" / "a_scene" / "7.h5", 7)
     ds = NyuH5Dataset(tmp_path / "data", "val")  # the parent of nyudepthv2 works too
-    assert [ds[i].id for i in range(len(ds))] == ["nyu/val/a_scene/7", "nyu/val/official/1", "nyu/val/official/2", "nyu/val/official/10"]
+    assert [ds[i].id for i in range(len(ds))] == ["nyu/val/a_scene/7", "nyu/val/official/1", "nyu/val/official/2",
+                                                  "nyu/val/official/10"]
     s = ds[3]
     rgb, depth = written[10]
     assert np.array_equal(s.rgb, rgb) and s.depth.dtype == np.float32
@@ -104,7 +105,8 @@ def test_nyu_h5_values_ids_order(tmp_path):
 
 
 def test_nyu_h5_errors(tmp_path):
-    with pytest.raises(DatasetError, match=r"(?s)not found: .*missing/val.*Expected layout.*nyudepthv2.*sparse-to-dense"):
+    with pytest.raises(DatasetError,
+                       match=r"(?s)not found: .*missing/val.*Expected layout.*nyudepthv2.*sparse-to-dense"):
         NyuH5Dataset(tmp_path / "missing", "val")
     bad = tmp_path / "nyudepthv2" / "train" / "s" / "1.h5"
     bad.parent.mkdir(parents=True)
@@ -129,12 +131,14 @@ def test_nyu_tfds_missing_package_error():
 
 # ---- KITTI depth completion ------------------------------------------------------------------------------------
 
-CALIB = """calib_time: 09-Jan-2012 13:57:47
-corner_dist: 9.950000e-02
-P_rect_00: 7.215377e+02 0.000000e+00 6.095593e+02 0.000000e+00 0.000000e+00 7.215377e+02 1.728540e+02 0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00 0.000000e+00
-P_rect_02: 7.215377e+02 0.000000e+00 6.095593e+02 4.485728e+01 0.000000e+00 7.215377e+02 1.728540e+02 2.163791e-01 0.000000e+00 0.000000e+00 1.000000e+00 2.745884e-03
-P_rect_03: 7.205000e+02 0.000000e+00 6.090000e+02 -3.395242e+02 0.000000e+00 7.215377e+02 1.728540e+02 2.199936e+00 0.000000e+00 0.000000e+00 1.000000e+00 2.729905e-03
-"""
+CALIB = ("calib_time: 09-Jan-2012 13:57:47\n"
+         "corner_dist: 9.950000e-02\n"
+         "P_rect_00: 7.215377e+02 0.000000e+00 6.095593e+02 0.000000e+00 0.000000e+00 7.215377e+02 1.728540e+02 "
+         "0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00 0.000000e+00\n"
+         "P_rect_02: 7.215377e+02 0.000000e+00 6.095593e+02 4.485728e+01 0.000000e+00 7.215377e+02 1.728540e+02 "
+         "2.163791e-01 0.000000e+00 0.000000e+00 1.000000e+00 2.745884e-03\n"
+         "P_rect_03: 7.205000e+02 0.000000e+00 6.090000e+02 -3.395242e+02 0.000000e+00 7.215377e+02 1.728540e+02 "
+         "2.199936e+00 0.000000e+00 0.000000e+00 1.000000e+00 2.729905e-03\n")
 DRIVE = "2011_09_26_drive_0002_sync"
 
 
@@ -148,8 +152,10 @@ def make_kitti_tree(tmp_path, frames=("0000000005", "0000000010", "0000000100"),
             rng = np.random.default_rng(100 * c + f)
             gt = rng.integers(0, 80 * 256, (H, W)).astype(np.uint16)
             velo = np.where(rng.random((H, W)) < 0.3, gt, 0).astype(np.uint16)
-            write_png16(depth_root / "data_depth_annotated" / "val" / DRIVE / "proj_depth" / "groundtruth" / camera / f"{frame}.png", gt)
-            write_png16(depth_root / "data_depth_velodyne" / "val" / DRIVE / "proj_depth" / "velodyne_raw" / camera / f"{frame}.png", velo)
+            write_png16(depth_root / "data_depth_annotated" / "val" / DRIVE / "proj_depth" / "groundtruth" / camera
+                        / f"{frame}.png", gt)
+            write_png16(depth_root / "data_depth_velodyne" / "val" / DRIVE / "proj_depth" / "velodyne_raw" / camera
+                        / f"{frame}.png", velo)
             write_rgb(raw_root / DRIVE[:10] / DRIVE / camera / "data" / f"{frame}.png", pattern_rgb(100 * c + f))
             raws[(camera, frame)] = (gt, velo)
     return depth_root, raw_root, raws
@@ -170,7 +176,8 @@ def test_kitti_depth_completion(tmp_path):
     frame = ds.frame(4)
     assert isinstance(frame, KittiFrame) and np.array_equal(frame.lidar, velo.astype(np.float32) / 256)
     # The scan as ground truth (Ma & Karaman's odometry protocol), and as a sampler with exactly N points.
-    assert np.array_equal(KittiDepthCompletion(depth_root, raw_root, "val", target="velodyne_raw")[4].depth, frame.lidar)
+    assert np.array_equal(KittiDepthCompletion(depth_root, raw_root, "val", target="velodyne_raw")[4].depth,
+                          frame.lidar)
     crop = Protocol("tiny", (BottomCrop(8, 12),), (8, 12), 0.0, 80.0)
     cropped = crop(s)
     real = KittiLidarInput(ds, crop)(cropped)
@@ -199,14 +206,16 @@ def test_kitti_errors(tmp_path):
 
 def test_kitti_selection(tmp_path):
     root = tmp_path / "depth_selection" / "val_selection_cropped"
-    frames = [("2011_09_26_drive_0002_sync", "0000000005", "image_02"), ("2011_09_26_drive_0002_sync", "0000000005", "image_03"),
+    frames = [("2011_09_26_drive_0002_sync", "0000000005", "image_02"),
+              ("2011_09_26_drive_0002_sync", "0000000005", "image_03"),
               ("2011_09_26_drive_0001_sync", "0000000011", "image_02")]
     for i, (d, f, c) in enumerate(frames):
         write_rgb(root / "image" / f"{d}_image_{f}_{c}.png", pattern_rgb(i))
         write_png16(root / "velodyne_raw" / f"{d}_velodyne_raw_{f}_{c}.png", np.full((H, W), 256 * (i + 1)))
         write_png16(root / "groundtruth_depth" / f"{d}_groundtruth_depth_{f}_{c}.png", np.full((H, W), 512 * (i + 1)))
         (root / "intrinsics").mkdir(exist_ok=True)
-        (root / "intrinsics" / f"{d}_image_{f}_{c}.txt").write_text(f"{700 + i} 0.0 600.0 0.0 {700 + i} 170.0 0.0 0.0 1.0\n")
+        (root / "intrinsics" / f"{d}_image_{f}_{c}.txt").write_text(
+            f"{700 + i} 0.0 600.0 0.0 {700 + i} 170.0 0.0 0.0 1.0\n")
     ds = KittiSelection(tmp_path)
     assert ds.ids == ["kitti/selection/2011_09_26_drive_0001_sync/image_02/0000000011",
                       "kitti/selection/2011_09_26_drive_0002_sync/image_02/0000000005",
@@ -235,7 +244,8 @@ def test_tartanair(tmp_path):
     assert len(splits["all"]) == 49
     trajs = {s: {f[0] for f in ds.frames} for s, ds in splits.items()}
     assert trajs["train"] | trajs["val"] | trajs["test"] == set(trajectories)
-    assert not (trajs["train"] & trajs["val"]) and not (trajs["train"] & trajs["test"]) and not (trajs["val"] & trajs["test"])
+    assert (not (trajs["train"] & trajs["val"]) and not (trajs["train"] & trajs["test"])
+            and not (trajs["val"] & trajs["test"]))
     assert len(trajs["val"]) >= 1 and len(trajs["test"]) >= 1 and len(trajs["train"]) >= 20
     s = splits["all"][1]
     assert s.id == "tartanair/env0/Easy/P000/000001" and s.intrinsics == TARTANAIR_INTRINSICS

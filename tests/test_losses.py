@@ -56,7 +56,8 @@ def test_deep_supervision_adds_weighted_iterate_losses():
     valid = jnp.ones((1, 2, 2), bool)
     final = gt + 1.0  # loss 1
     iterates = jnp.stack([gt + 2.0, gt + 3.0])  # losses 4, 9
-    assert float(supervised_loss(final, iterates, gt, valid, iteration_weights=(0.5, 0.1))) == pytest.approx(1 + 2 + 0.9)
+    assert (float(supervised_loss(final, iterates, gt, valid, iteration_weights=(0.5, 0.1)))
+            == pytest.approx(1 + 2 + 0.9))
     assert float(supervised_loss(final, None, gt, valid)) == pytest.approx(1.0)
 
 
@@ -103,6 +104,8 @@ def test_discriminator_ignores_depth_at_invalid_ground_truth_pixels():
     rgb = jnp.asarray(rng.random((1, 16, 16, 3)), jnp.float32)
     depth = jnp.asarray(rng.uniform(1, 9, (1, 16, 16)), jnp.float32)
     changed_where_invalid = jnp.where(valid, depth, 123.0)
-    np.testing.assert_allclose(d.apply(params, depth, rgb, valid), d.apply(params, changed_where_invalid, rgb, valid), rtol=1e-6)
+    np.testing.assert_allclose(d.apply(params, depth, rgb, valid), d.apply(params, changed_where_invalid, rgb, valid),
+                               rtol=1e-6)
     changed_where_valid = jnp.where(valid, depth + 1.0, depth)
-    assert float(jnp.abs(d.apply(params, depth, rgb, valid) - d.apply(params, changed_where_valid, rgb, valid)).max()) > 1e-6
+    assert float(jnp.abs(d.apply(params, depth, rgb, valid)
+                         - d.apply(params, changed_where_valid, rgb, valid)).max()) > 1e-6

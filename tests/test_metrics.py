@@ -137,7 +137,8 @@ def test_batch_helper_matches_per_image_and_accepts_jax_arrays():
     valid = rng.uniform(size=gt.shape) > 0.3
     pred = gt + rng.normal(0, 0.2, gt.shape).astype(np.float32)
     sparse = np.where(rng.uniform(size=gt.shape) > 0.7, gt, 0).astype(np.float32)
-    batch = compute_metrics_batch(jnp.asarray(pred), jnp.asarray(gt), jnp.asarray(valid), jnp.asarray(sparse), max_depth_m=4.0)
+    batch = compute_metrics_batch(jnp.asarray(pred), jnp.asarray(gt), jnp.asarray(valid), jnp.asarray(sparse),
+                                  max_depth_m=4.0)
     for i in range(3):
         single = compute_metrics(pred[i], gt[i], valid[i], sparse[i], max_depth_m=4.0)
         assert batch[i].keys() == single.keys()

@@ -163,7 +163,8 @@ def test_baseline_training_configs_copy_the_lip_runs():
     from experiments import configs
     from experiments.configs import BASELINE_CONFIGS
 
-    assert sorted(BASELINE_CONFIGS) == sorted(f"{m}_{s}" for m in ("ma2018", "unet", "cspn") for s in ("indoor", "outdoor"))
+    assert sorted(BASELINE_CONFIGS) == sorted(f"{m}_{s}" for m in ("ma2018", "unet", "cspn")
+                                              for s in ("indoor", "outdoor"))
     for key, config in BASELINE_CONFIGS.items():
         scene = key.split("_")[1]
         lip = configs.LIP_CNN_INDOOR if scene == "indoor" else configs.LIP_CNN_OUTDOOR

@@ -20,7 +20,8 @@ def _problem(seed, shape=(3, 4), weights=False):
 
 
 def _objective(x, y, w, z, u, rho):
-    """Eq. 6 with A = diag(sqrt(w)) so that ||y - A x||^2 weighs pixel i by w_i: 1/2 sum w (y-x)^2 + rho/2 ||x-z+u||^2."""
+    """Eq. 6 with A = diag(sqrt(w)) so that ||y - A x||^2 weighs pixel i by w_i:
+    1/2 sum w (y-x)^2 + rho/2 ||x-z+u||^2."""
     return 0.5 * jnp.sum(w * (y - x) ** 2) + 0.5 * rho * jnp.sum((x - z + u) ** 2)
 
 

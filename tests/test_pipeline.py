@@ -39,7 +39,8 @@ def batches_equal(a: Batch, b: Batch) -> bool:
 
 
 def make(dataset=None, **kwargs) -> BatchIterator:
-    return BatchIterator(dataset if dataset is not None else fake_dataset(), kwargs.pop("batch_size", 3), UniformSampler(5), **kwargs)
+    return BatchIterator(dataset if dataset is not None else fake_dataset(), kwargs.pop("batch_size", 3),
+                         UniformSampler(5), **kwargs)
 
 
 def test_batch_contents():
@@ -200,5 +201,6 @@ print("SHARDED_OK")
 
 def test_shard_batch_over_four_forced_host_devices():
     env = {**os.environ, "XLA_FLAGS": "--xla_force_host_platform_device_count=4", "JAX_PLATFORMS": "cpu"}
-    result = subprocess.run([sys.executable, "-c", MULTI_DEVICE_SCRIPT], env=env, capture_output=True, text=True, timeout=120)
+    result = subprocess.run([sys.executable, "-c", MULTI_DEVICE_SCRIPT], env=env, capture_output=True, text=True,
+                            timeout=120)
     assert result.returncode == 0 and "SHARDED_OK" in result.stdout, result.stderr[-3000:]

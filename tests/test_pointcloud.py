@@ -10,7 +10,8 @@ K = Intrinsics(fx=30.0, fy=28.0, cx=15.5, cy=11.0)
 
 
 def _plane_depth(normal=(0.1, -0.2, 1.0), offset=3.0):
-    """z of the plane n . p = offset seen through every pixel: z = offset / (n . ray), ray = ((u-cx)/fx, (v-cy)/fy, 1)."""
+    """z of the plane n . p = offset seen through every pixel: z = offset / (n . ray),
+    ray = ((u-cx)/fx, (v-cy)/fy, 1)."""
     v, u = np.mgrid[0:H, 0:W]
     rays = np.stack([(u - K.cx) / K.fx, (v - K.cy) / K.fy, np.ones((H, W))], -1)
     return (offset / (rays @ np.asarray(normal))).astype(np.float32), np.asarray(normal), offset

@@ -77,7 +77,8 @@ def test_nyu_paper_exact_window_and_intrinsics():
     assert rows.min() >= 8 and rows.max() <= 471 and cols.min() >= 30 and cols.max() <= 609
     k = out.intrinsics
     assert k.fx == pytest.approx(K_NYU.fx / s) and k.fy == pytest.approx(K_NYU.fy / s)
-    assert k.cx == pytest.approx((K_NYU.cx - 30 + 0.5) / s - 0.5) and k.cy == pytest.approx((K_NYU.cy - 8 + 0.5) / s - 0.5)
+    assert (k.cx == pytest.approx((K_NYU.cx - 30 + 0.5) / s - 0.5)
+            and k.cy == pytest.approx((K_NYU.cy - 8 + 0.5) / s - 0.5))
 
 
 @pytest.mark.parametrize("name,in_size,k", [("nyu_paper", (480, 640), K_NYU), ("nyu_ma", (480, 640), K_NYU),

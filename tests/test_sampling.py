@@ -89,12 +89,14 @@ def test_uniform_independent_of_process_and_hash_seed():
         "import json, numpy as np\n"
         "from lipjax.data.sample import Sample, Intrinsics\n"
         "from lipjax.data.sampling import UniformSampler\n"
-        "s = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1,1,0,0), 'nyu/val/x/1')\n"
+        "s = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), "
+        "Intrinsics(1,1,0,0), 'nyu/val/x/1')\n"
         "print(json.dumps(np.flatnonzero(UniformSampler(25)(s, seed=7)).tolist()))\n"
     )
     env = {**os.environ, "PYTHONHASHSEED": "12345"}
     result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    here = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1, 1, 0, 0), "nyu/val/x/1")
+    here = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1, 1, 0, 0),
+                             "nyu/val/x/1")
     assert json.loads(result.stdout) == np.flatnonzero(UniformSampler(25)(here, seed=7)).tolist()
 
 
@@ -207,7 +209,8 @@ def test_sampler_from_spec():
     assert sampler_from_spec("lidar:vlp16") == LidarSampler.vlp16()
     s = sampler_from_spec("lidar:vlp32,azimuth_step_deg=0.4+noise:std=0.02,rel=0.01,outliers=0.05")
     assert s == Noisy(dataclasses.replace(LidarSampler.vlp32(), azimuth_step_deg=0.4), Noise(0.02, 0.01, 0.05))
-    for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1", "uniform:3+blur:1"):
+    for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1",
+                "uniform:3+blur:1"):
         with pytest.raises(ValueError):
             sampler_from_spec(bad)
 

@@ -33,7 +33,8 @@ CONFIG = TrainConfig(
 
 
 def _leaves_equal(a, b):
-    return all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
+    return all(np.array_equal(np.asarray(x), np.asarray(y))
+               for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
 
 
 @pytest.fixture(scope="module")
@@ -137,7 +138,8 @@ def test_two_processes_match_one_process(straight_run, tmp_path):
         got = [multi[f"arr_{i}"] for i in range(len(multi.files))]
     want = [np.asarray(a) for a in jax.tree_util.tree_leaves(single.g_params)]
     assert len(got) == len(want)
-    assert max(float(np.abs(b - i).max()) for b, i in zip(want, jax.tree_util.tree_leaves(init_state(CONFIG).g_params))) > 1e-4
+    assert max(float(np.abs(b - i).max())
+               for b, i in zip(want, jax.tree_util.tree_leaves(init_state(CONFIG).g_params))) > 1e-4
     for a, b in zip(got, want):
         # Different reduction orders give float-level differences, which Adam turns into update-sized ones on
         # parameters whose gradient is ~0; 1e-5 is 1 % of one step (learning rate 1e-3).

@@ -4,7 +4,15 @@ import numpy as np
 import pytest
 from scipy import optimize
 
-from lipjax.priors.wavelet import WaveletPrior, cycle_offsets, dwt2, idwt2, soft_threshold, transform_matrix, wavelet_shrink
+from lipjax.priors.wavelet import (
+    WaveletPrior,
+    cycle_offsets,
+    dwt2,
+    idwt2,
+    soft_threshold,
+    transform_matrix,
+    wavelet_shrink,
+)
 
 WAVELETS = ["haar", "db2"]
 
@@ -50,10 +58,12 @@ def _brute_force_prox(v: np.ndarray, tau: float, wd: np.ndarray) -> np.ndarray:
     def grad(u):
         return np.concatenate([u[:n] - v, np.full(2 * m, tau)])
 
-    cons = {"type": "eq", "fun": lambda u: wd @ u[:n] - u[n : n + m] + u[n + m :], "jac": lambda u: np.hstack([wd, -np.eye(m), np.eye(m)])}
+    cons = {"type": "eq", "fun": lambda u: wd @ u[:n] - u[n : n + m] + u[n + m :],
+            "jac": lambda u: np.hstack([wd, -np.eye(m), np.eye(m)])}
     u0 = np.concatenate([v, np.maximum(wd @ v, 0), np.maximum(-wd @ v, 0)])
     bounds = [(None, None)] * n + [(0, None)] * (2 * m)
-    res = optimize.minimize(f, u0, jac=grad, constraints=[cons], bounds=bounds, method="SLSQP", options={"ftol": 1e-12, "maxiter": 500})
+    res = optimize.minimize(f, u0, jac=grad, constraints=[cons], bounds=bounds, method="SLSQP",
+                            options={"ftol": 1e-12, "maxiter": 500})
     assert res.success, res.message
     return res.x[:n]
 

@@ -227,7 +227,7 @@ class RenderedDataset:
         return self.count
 
     @property
-    def kinds(self) -> tuple[str]:
+    def kinds(self) -> tuple[str, ...]:
         """The kinds of scene in the data set (as RenderedMixture.kinds)."""
         return (self.kind,)
 
@@ -313,4 +313,3 @@ def open_rendered(root: str | os.PathLike) -> RenderedDataset | RenderedMixture:
     if len(roots) == 1:
         return RenderedDataset(roots[0])
     return RenderedMixture([RenderedDataset(r) for r in roots])
-
