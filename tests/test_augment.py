@@ -4,7 +4,15 @@ import dataclasses
 import numpy as np
 import pytest
 
-from lipjax.data.augment import DEFAULT_TRAINING, Augment, augment_batch, move_samples, perturb_samples, photometric
+from lipjax.data.augment import (
+    DEFAULT_TRAINING,
+    Augment,
+    augment_batch,
+    move_samples,
+    paint_texture,
+    perturb_samples,
+    photometric,
+)
 from lipjax.data.sample import Batch
 
 
@@ -84,6 +92,30 @@ def test_sensor_noise_is_relative_and_outliers_only_push_samples_back():
     moved = ratio != 1
     assert abs(moved.mean() - 0.1) < 0.01
     assert ratio[moved].min() >= 1.1 and ratio[moved].max() <= 3.0
+
+
+def test_texture_paints_the_rgb_of_a_rectangle_and_nothing_else():
+    """texture_prob=1: the RGB changes inside one rectangle only, by at most the strength (relative), while depth,
+    samples and validity are exactly those of the same augmentation without texture; texture_prob=0 draws nothing."""
+    b = _batch(n=6)
+    rgb = np.full((40, 48, 3), 128, np.uint8)
+    for seed in range(20):
+        out = paint_texture(rgb, 0.4, np.random.default_rng(seed)).astype(float)
+        changed = np.nonzero(np.abs(out - 128).max(-1) > 0)
+        assert np.abs(out - 128).max() <= 0.4 * 128 + 0.5
+        if changed[0].size:  # the changed pixels lie in one rectangle of at least a quarter of each side
+            rows, cols = changed
+            assert rows.max() - rows.min() + 1 >= 40 // 4 - 1 and cols.max() - cols.min() + 1 >= 48 // 4 - 1
+    painted = sum(int(np.any(paint_texture(rgb, 0.4, np.random.default_rng(s)) != rgb)) for s in range(20))
+    assert painted >= 15  # a zero amplitude or a flat pattern is rare
+    plain = augment_batch(b, DEFAULT_TRAINING, (24, 32), seed=1, step=5)
+    textured = augment_batch(b, dataclasses.replace(DEFAULT_TRAINING, texture_prob=1.0), (24, 32), seed=1, step=5)
+    for name in ("gt", "sparse", "gt_valid"):
+        np.testing.assert_array_equal(getattr(plain, name), getattr(textured, name))
+    assert not np.array_equal(plain.rgb, textured.rgb)
+    off = augment_batch(b, dataclasses.replace(DEFAULT_TRAINING, texture_prob=0.0, texture_strength=0.1), (24, 32),
+                        seed=1, step=5)
+    np.testing.assert_array_equal(plain.rgb, off.rgb)
 
 
 def test_bad_settings_are_clear_errors():

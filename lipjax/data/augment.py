@@ -18,7 +18,11 @@ What each part is for (real sensors and real frames differ from the synthetic re
 - sensor noise: every sample's depth times (1 + n), n ~ N(0, depth_noise) (LiDAR range noise is roughly
   proportional to range at these scales);
 - outliers: a fraction of the samples pushed behind their true depth by a factor in [1.1, 3] (the LiDAR and the
-  camera see an edge from different viewpoints, so some returns come from the background: "bleed-through").
+  camera see an edge from different viewpoints, so some returns come from the background: "bleed-through");
+- texture: with probability `texture_prob`, a procedural pattern painted on a random rectangle of the RGB and
+  nowhere in the depth (`paint_texture`): real surfaces carry print, grain and clutter that the renders' flat
+  materials lack, so a prox trained on renders alone learns that every colour edge is a depth edge and, on
+  real frames (e.g. Middlebury's shelves), invents depth steps at texture.
 Ground truth is only cropped, zoomed and flipped: the model learns to undo the noise and the outliers.
 """
 from __future__ import annotations
@@ -48,6 +52,8 @@ class Augment:
     blur_sigma_px: float = 1.5
     depth_noise: float = 0.0
     outlier_fraction: float = 0.0
+    texture_prob: float = 0.0
+    texture_strength: float = 0.4
 
     def __post_init__(self):
         lo, hi = self.zoom
@@ -56,8 +62,10 @@ class Augment:
         for name in ("brightness", "contrast", "saturation"):
             if not 0 <= getattr(self, name) < 1:
                 raise ValueError(f"{name} must be in [0, 1), got {getattr(self, name)}")
-        if not (0 <= self.blur_prob <= 1 and 0 <= self.outlier_fraction <= 1):
-            raise ValueError("blur_prob and outlier_fraction are probabilities in [0, 1]")
+        if not (0 <= self.blur_prob <= 1 and 0 <= self.outlier_fraction <= 1 and 0 <= self.texture_prob <= 1):
+            raise ValueError("blur_prob, outlier_fraction and texture_prob are probabilities in [0, 1]")
+        if not 0 <= self.texture_strength < 1:
+            raise ValueError(f"texture_strength must be in [0, 1), got {self.texture_strength}")
         if self.gamma < 0 or self.depth_noise < 0 or self.blur_sigma_px <= 0:
             raise ValueError("gamma and depth_noise must be >= 0 and blur_sigma_px > 0")
 
@@ -118,6 +126,35 @@ def photometric(rgb: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.n
     return np.round(x * 255.0).astype(np.uint8)
 
 
+TEXTURE_PERIOD_PX = (3.0, 40.0)  # wavelength range of the painted stripes and blotches, pixels
+
+
+def paint_texture(rgb: np.ndarray, strength: float, rng: np.random.Generator) -> np.ndarray:
+    """(H, W, 3) uint8 -> uint8 with a pattern p in [-1, 1] multiplied in, rgb * (1 + a p), a in [0, strength],
+    on a random rectangle (a quarter to all of each side). The pattern is, with equal odds, stripes (a sinusoid
+    of random direction, period and phase, optionally squared off like print), or blotches (uniform noise on a
+    coarse grid, bicubically enlarged: grain, marble, foliage); grey or per-channel."""
+    h, w = rgb.shape[:2]
+    rh, rw = (int(rng.integers(max(1, n // 4), n + 1)) for n in (h, w))
+    top, left = int(rng.integers(0, h - rh + 1)), int(rng.integers(0, w - rw + 1))
+    period = float(np.exp(rng.uniform(*np.log(TEXTURE_PERIOD_PX))))
+    channels = 3 if rng.random() < 0.5 else 1
+    if rng.random() < 0.5:
+        theta, phase = rng.uniform(0, np.pi, channels), rng.uniform(0, 2 * np.pi, channels)
+        y, x = np.mgrid[0:rh, 0:rw].astype(np.float32)
+        along = x[..., None] * np.cos(theta) + y[..., None] * np.sin(theta)
+        pattern = np.sin(2 * np.pi * along / period + phase)
+        if rng.random() < 0.5:
+            pattern = np.sign(pattern)
+    else:
+        grid = rng.uniform(-1, 1, (max(2, int(rh / period) + 2), max(2, int(rw / period) + 2), channels))
+        pattern = cv2.resize(grid.astype(np.float32), (rw, rh), interpolation=cv2.INTER_CUBIC).reshape(rh, rw, -1)
+    factor = 1.0 + rng.uniform(0, strength) * np.clip(pattern, -1.0, 1.0)
+    out = rgb.astype(np.float32)
+    out[top:top + rh, left:left + rw] *= factor
+    return np.clip(np.round(out), 0, 255).astype(np.uint8)
+
+
 def perturb_samples(sparse: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.ndarray:
     """Sensor noise and bleed-through outliers on the samples of (H, W) sparse depth in metres (0 stays 0)."""
     out = sparse.copy()
@@ -139,6 +176,8 @@ def augment_example(rgb, sparse, gt, valid, crop, aug: Augment, rng: np.random.G
     rgb, sparse, gt, valid = _zoomed_crop(rgb, sparse, gt, valid, crop, scale, rng)
     if aug.hflip and rng.random() < 0.5:
         rgb, sparse, gt, valid = (a[:, ::-1] for a in (rgb, sparse, gt, valid))
+    if aug.texture_prob and rng.random() < aug.texture_prob:  # on the surfaces, before the camera's effects
+        rgb = paint_texture(np.ascontiguousarray(rgb), aug.texture_strength, rng)
     if aug.brightness or aug.contrast or aug.saturation or aug.gamma:
         rgb = photometric(rgb, aug, rng)
     if aug.blur_prob and rng.random() < aug.blur_prob:
