@@ -136,7 +136,7 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         dataset = open_rendered(root)  # reads index.json only: the kind check holds for both splits
         first = dataset.kinds[0]
         if first != data.kind:  # several folders: the first names the val split and the depth range
-            raise ValueError(f"{root} holds {first} renders{' first' if ',' in root else ''} but "
+            raise ValueError(f"{root} holds {first} renders{' first' if len(dataset.kinds) > 1 else ''} but "
                              f"data.kind={data.kind!r}; add --set data.kind={first}")
         if split == "val" and not render_frames:  # the fixed on-the-fly val set of the kind: comparable across runs
             return SyntheticDataset(data.kind, "val", size=data.val_images, height=data.height, width=data.width), None
