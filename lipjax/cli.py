@@ -251,10 +251,11 @@ def _cmd_evaluate(args) -> int:
                                               depth_scale=args.depth_scale, kind=args.kind)
         dataset, sampler = source.dataset, source.sampler  # protocol applied
         if args.source == "rendered":
-            from lipjax.data.rendered import RenderedDataset
+            from lipjax.data.rendered import RenderedMixture, open_rendered
 
-            render = RenderedDataset(args.root)
-            data_name = f"rendered {render.kind}/{render.split} ({args.root})"
+            render = open_rendered(args.root)
+            parts = render.parts if isinstance(render, RenderedMixture) else [render]
+            data_name = f"rendered {' + '.join(f'{p.kind}/{p.split}' for p in parts)} ({args.root})"
         else:
             kind = f" {args.kind or 'indoor'}" if args.source == "synthetic" else ""
             data_name = f"{args.source}{kind} {split}" + (f" ({args.root})" if args.root else "")
@@ -409,7 +410,8 @@ def build_parser() -> argparse.ArgumentParser:
     data.add_argument("--source", default=None, choices=SOURCES,
                       help="a training data source, read as training reads it (lipjax.data.sources); its default "
                            "protocol's crop and depth range unless --protocol says otherwise")
-    e.add_argument("--root", default=None, metavar="DIR", help="the folder of the --source data set")
+    e.add_argument("--root", default=None, metavar="DIR",
+                   help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
     e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", default=None, choices=("train", "val", "test"),
                    help="synthetic split (default test); with --source train or val (default val); --source rendered "

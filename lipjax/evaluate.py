@@ -108,7 +108,7 @@ def open_eval_source(
     Args:
       source, root, raw_root, depth_scale: the data set, as lipjax.train.config.DataConfig names them.
       split: "val" or "train". source="rendered" evaluates the frames in `root` whatever the split (training
-        validates on the synthetic val split instead).
+        validates on the synthetic val split instead); a comma-separated list of folders of one kind is one set.
       sampler: the sparse input, a lipjax.data.sampling spec or "input[:N]" (the data set's own sparse input).
       protocol: a lipjax.data.protocols name, "none" (frames as they are) or None (the source's default).
       kind: "indoor" or "outdoor", the synthetic scenes of source="synthetic" (default indoor), rendered at the
@@ -120,14 +120,17 @@ def open_eval_source(
       synthetic_<kind> for the synthetic scenes; None for a folder, whose range the caller gives). Raises
       ValueError (DatasetError, naming the expected layout) for a missing or malformed root.
     """
-    from lipjax.data.rendered import TRAINING_SIZES, RenderedDataset
+    from lipjax.data.rendered import TRAINING_SIZES, open_rendered
     from lipjax.train.config import DataConfig
 
     if source == "rendered" and root is not None:
-        rendered = RenderedDataset(root).kind
-        if kind not in (None, rendered):
-            raise ValueError(f"{root} holds {rendered} renders, not {kind}")
-        kind = rendered
+        kinds = sorted(set(open_rendered(root).kinds))
+        if len(kinds) > 1:
+            raise ValueError(f"{root} mixes {' and '.join(kinds)} renders, scored over different depth ranges; "
+                             "evaluate one kind at a time")
+        if kind not in (None, kinds[0]):
+            raise ValueError(f"{root} holds {kinds[0]} renders, not {kind}")
+        kind = kinds[0]
     elif kind is not None and source != "synthetic":
         raise ValueError(f"kind={kind!r} is for source 'synthetic' (or 'rendered'), not {source!r}")
     kind = kind or "indoor"

@@ -372,6 +372,16 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
     assert cli.main(["evaluate", "--source", "rendered", "--root", str(out), "--model", "nearest", "--quiet",
                      "--json", str(tmp_path / "results.json")]) == 0
     assert "data: rendered outdoor/val" in capsys.readouterr().out
+    more = render_to_disk("outdoor", "train", 1, tmp_path / "r2", height=H, width=W, workers=1, progress=False)
+    assert cli.main(["evaluate", "--source", "rendered", "--root", f"{out},{more}", "--model", "nearest", "--quiet",
+                     "--json", str(tmp_path / "both.json")]) == 0  # several folders of one kind: one set
+    assert "data: rendered outdoor/val + outdoor/train" in capsys.readouterr().out
+    both = json.loads((tmp_path / "both.json").read_text())["nearest"]
+    assert [r["id"] for r in both["per_image"]] == [RenderedDataset(out)[0].id, RenderedDataset(out)[1].id,
+                                                     RenderedDataset(more)[0].id]
+    rooms = render_to_disk("indoor", "val", 1, tmp_path / "r3", height=H, width=W, workers=1, progress=False)
+    with pytest.raises(ValueError, match="mixes indoor and outdoor renders"):
+        open_eval_source("rendered", f"{out},{rooms}")
     outdoor = get_protocol("synthetic_outdoor")
     want = evaluate(get_completer("nearest", None), RenderedDataset(out), sampler_from_spec("uniform:200"),
                     min_depth_m=outdoor.min_depth_m, max_depth_m=outdoor.max_depth_m, progress=False)
