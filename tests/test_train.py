@@ -231,27 +231,39 @@ def _children(pid: int) -> set[int]:
 
 
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
-def test_sigterm_stops_the_loader_workers_with_the_run(tmp_path):
-    """A killed run (SIGTERM) exits with 143 and takes its loader worker process with it; it resumes later."""
+def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
+    """A killed run (SIGTERM) saves the step it was in, although no checkpoint was due, exits with 143 and takes
+    its loader worker process with it; the checkpoint restores at that step, with its data position."""
     workdir = tmp_path / "run"
     cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
-           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=1"]
+           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=100000",
+           "--set", "log_every=1", "--set", "eval_every=0"]
     proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL)
+    metrics = workdir / "metrics.jsonl"
     try:
         deadline = time.time() + 240
-        while not list((workdir / "checkpoints").glob("[0-9]*")) and time.time() < deadline:
-            time.sleep(0.5)
+        while not (metrics.exists() and metrics.read_text().count("\n") >= 2) and time.time() < deadline:
+            time.sleep(0.2)
         workers = _children(proc.pid)
         assert workers, "the run should have a loader worker process"
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=60) == 143
     finally:
         proc.kill()
+    logged = [json.loads(line)["step"] for line in metrics.read_text().splitlines()]
+    saved = [int(p.name) for p in (workdir / "checkpoints").glob("[0-9]*")]
+    assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
     deadline = time.time() + 20
     while [w for w in workers if _alive(w)] and time.time() < deadline:
         time.sleep(0.2)
     assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
+    from experiments.configs import get_config
+
+    manager = CheckpointManager(workdir / "checkpoints")
+    state, meta = manager.restore(init_state(get_config("smoke")))  # what a resumed run starts from
+    manager.close()
+    assert int(state.step) == meta["data_position"] == saved[0] and meta["data_loader"]["next_step"] == saved[0]
 
 
 def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_path, capsys):

@@ -86,21 +86,36 @@ def _initial_g_params(config: TrainConfig):
     return params
 
 
+class _Stop:
+    """What SIGTERM (kill, a scheduler's stop, a preemption notice) asked of a training run."""
+
+    def __init__(self):
+        self.requested = False
+
+
 @contextlib.contextmanager
-def _sigterm_as_exit():
-    """SIGTERM (kill, a scheduler's stop) raises SystemExit(143) in the main thread while training, so that the
-    `finally` blocks run: the loader's worker processes stop with the run instead of outliving it. The last
-    checkpoint is kept; started again, the run resumes from it. No-op outside the main thread."""
+def _sigterm_as_exit(save_first: bool):
+    """SIGTERM ends a training run with SystemExit(143) so that the `finally` blocks run: the loader's worker
+    processes stop with the run instead of outliving it; started again, the run resumes.
+
+    save_first (a single-process run): the first SIGTERM only sets `requested`; the loop then finishes the step
+    it is in, saves a checkpoint of it and exits, so a preempted run loses no step. A second SIGTERM exits at
+    once (the last saved checkpoint is kept). A multi-process run exits at once: a checkpoint is a collective
+    write that every process would have to reach at the same step. No-op outside the main thread."""
+    stop = _Stop()
     if threading.current_thread() is not threading.main_thread():
-        yield
+        yield stop
         return
 
-    def stop(signum, frame):
+    def on_sigterm(signum, frame):
+        if save_first and not stop.requested:
+            stop.requested = True
+            return
         raise SystemExit(128 + signum)
 
-    previous = signal.signal(signal.SIGTERM, stop)
+    previous = signal.signal(signal.SIGTERM, on_sigterm)
     try:
-        yield
+        yield stop
     finally:
         signal.signal(signal.SIGTERM, previous)
 
@@ -162,7 +177,7 @@ def train(
     t_last, images = time.perf_counter(), 0
     step = start
     try:
-        with _sigterm_as_exit(), loader:
+        with _sigterm_as_exit(save_first=process_count == 1) as stop, loader:
             for step in range(start, end):
                 batch = next(loader)
                 phase = config.phase(step)
@@ -189,9 +204,13 @@ def train(
                     if log:
                         log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
                         log.flush()
-                if done % config.checkpoint_every == 0 or done == end:
+                if done % config.checkpoint_every == 0 or done == end or stop.requested:
                     manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
                                                "data_loader": loader.state()})
+                if stop.requested and done < end:
+                    bar.write(f"[lipjax] SIGTERM: saved step {done} in {manager.directory}; stopping (run again to "
+                              "resume)")
+                    raise SystemExit(128 + signal.SIGTERM)
                 if val and (done % config.eval_every == 0 or done == end):
                     # every process evaluates (the parameters live on all of them); the main one logs
                     vm = evaluate_params(config.model, state.g_params, val, max_depth)
