@@ -74,18 +74,24 @@ class Completer:
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
-        rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name)
+        rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained)
         depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, self.config.host_inputs(sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
-        rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name)
+        rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained)
         return compiled_apply(self.config, True)(self.params, rgb, sparse, self.config.host_inputs(sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)
+
+    @property
+    def scan_lines_trained(self) -> bool:
+        """Whether the model's training input included LiDAR scan lines (its metadata's `train_sampler`, a
+        lipjax.data.sampling spec, recorded at export)."""
+        return "lidar:" in str(self.metadata.get("train_sampler", ""))
 
 
 def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:

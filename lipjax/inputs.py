@@ -16,6 +16,7 @@ cause (the same text for every frame, so a folder of frames warns once):
                                                           39 m): use the outdoor model; else a millimetre (Kinect)
                                                           PNG read with --depth-scale 256, or outdoor data
     indoor model, samples in LiDAR scan lines             warning: trained on scattered points, not scan lines
+                                                          (none for a model whose training included scan lines)
     outdoor model, median beyond 85 m or max beyond 340 m warning: centimetres given as metres?
     outdoor model, all within 10 m, no scan lines         warning: looks like indoor data
     outdoor model, a dense map within 39 m                warning: a millimetre PNG read with --depth-scale 256?
@@ -49,14 +50,14 @@ class InputError(ValueError):
     """Bad input to a completer: the message names the problem."""
 
 
-def check_inputs(rgb, sparse, max_depth_m: float | None = None,
-                 name: str = "this model") -> tuple[np.ndarray, np.ndarray, bool]:
+def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "this model",
+                 scan_lines_trained: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
     """Validates and batches inputs. Returns (rgb (B,H,W,3) uint8|float32, sparse (B,H,W) float32, was_batched).
 
     Raises InputError for: a wrong rank or channel count, an rgb dtype other than uint8 / float in [0, 1],
     mismatching sizes, non-float sparse depth (a raw PNG), NaN / inf or negative depth, an image without any
     sample, and depth that is clearly not metres. With `max_depth_m`, the range (metres) of the model `name`,
-    also `check_for_model`.
+    also `check_for_model` (scan_lines_trained: the model's training input included LiDAR scan lines).
     """
     rgb = np.asarray(rgb)
     sparse = np.asarray(sparse)
@@ -87,7 +88,7 @@ def check_inputs(rgb, sparse, max_depth_m: float | None = None,
     if median > MAX_PLAUSIBLE_DEPTH_M:
         raise InputError(f"sparse depth has a median of {median:.0f}: not metres (millimetres? divide by 1000)")
     if max_depth_m is not None:
-        check_for_model(sparse, max_depth_m, name)
+        check_for_model(sparse, max_depth_m, name, scan_lines_trained)
     if np.issubdtype(rgb.dtype, np.floating):
         rgb = rgb.astype(np.float32)
     return rgb, sparse.astype(np.float32), batched
@@ -139,10 +140,13 @@ def _other_model(name: str, scene: str) -> str:
     return twin if shipped_like and twin in model_io.available() else DEFAULT_MODELS[scene]
 
 
-def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model") -> None:
+def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model",
+                    scan_lines_trained: bool = False) -> None:
     """Compares checked (B, H, W) or (H, W) sparse depth (metres) with what a model of range `max_depth_m` was
     trained on: raises InputError where a unit mistake is near certain, warns (one line) where it is probable or
-    the input is unlike the training data. See the module docstring for the rules."""
+    the input is unlike the training data. See the module docstring for the rules. scan_lines_trained: the
+    model's training input included LiDAR scan lines (lipjax.inference.Completer.scan_lines_trained), so scan
+    lines are no warning for it."""
     sparse = np.asarray(sparse)
     samples = sparse[sparse > 0]
     median = float(np.median(samples))
@@ -160,7 +164,7 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
         elif np.quantile(samples, 0.75) > max_depth_m:
             _warn(f"sparse depth beyond the {max_depth_m:g} m range of the indoor model {name}: a millimetre PNG "
                   f"(Kinect, NYU) read with --depth-scale 256 (use 1000), or outdoor data (use {outdoor_model})?")
-        elif lidar:
+        elif lidar and not scan_lines_trained:
             _warn(f"samples in LiDAR scan lines, but the indoor model {name} was trained on scattered points: "
                   f"{outdoor_model} was trained on scan lines")
     elif median > max_depth_m or samples.max() > 4 * max_depth_m:

@@ -1,4 +1,5 @@
 """lipjax.inputs: unit and model-range checks, the LiDAR pattern test and the default-model choice."""
+import dataclasses
 import warnings
 
 import numpy as np
@@ -79,6 +80,13 @@ def test_scan_lines_within_range_on_the_indoor_model_warn_about_the_pattern():
     assert _messages(_lidar(3.0), INDOOR) == [
         "samples in LiDAR scan lines, but the indoor model lip-cnn-indoor was trained on scattered points: "
         "lip-cnn-outdoor was trained on scan lines"]
+
+
+def test_scan_lines_are_no_warning_for_an_indoor_model_trained_on_them():
+    assert _messages(_lidar(3.0), INDOOR + (True,)) == []
+    scattered = inference.Completer.random()
+    lidar = dataclasses.replace(scattered, metadata={"train_sampler": "uniform:200|lidar:hdl64,azimuth_step_deg=0.4"})
+    assert lidar.scan_lines_trained and not scattered.scan_lines_trained
 
 
 def test_far_too_few_samples_warn():

@@ -56,6 +56,8 @@ def test_smoke_run_goes_through_all_phases_logs_and_exports(straight_run, tmp_pa
     loop.export(CONFIG, state, tmp_path / "model")
     model = lipjax.load_model(tmp_path / "model")
     assert model.metadata["images_seen"] == CONFIG.total_steps * CONFIG.batch_size  # the budget, recorded
+    assert model.metadata["train_sampler"] == CONFIG.data.train_sampler  # and the training input
+    assert model.scan_lines_trained == ("lidar:" in CONFIG.data.train_sampler)
     # a run started from that model adds its budget to the one it started with
     follow = dataclasses.replace(CONFIG, init_from=str(tmp_path / "model"))
     loop.export(follow, state, tmp_path / "model2")

@@ -230,9 +230,11 @@ def train(
 def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
            metadata: dict[str, Any] | None = None) -> None:
     """Saves the trained G as a loadable model (lipjax.load_model(path)), with its training budget: `images_seen`
-    counts the training images of every step (batch size x steps), plus those of the model it started from."""
+    counts the training images of every step (batch size x steps), plus those of the model it started from; and
+    with its training input, `train_sampler` (what lipjax.inputs checks scan lines against)."""
     params = jax.tree_util.tree_map(to_host, state.g_params)
     before = model_io.metadata(config.init_from).get("images_seen", 0) if config.init_from else 0
     meta = {"train_config": config.name, "steps": int(state.step),
-            "images_seen": before + int(state.step) * config.batch_size, **(metadata or {})}
+            "images_seen": before + int(state.step) * config.batch_size,
+            "train_sampler": config.data.train_sampler, **(metadata or {})}
     model_io.save(path, config.model, params, meta)
