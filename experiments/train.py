@@ -3,6 +3,7 @@
     python -m experiments.train --config lip_cnn_indoor [--workdir runs/lip_cnn_indoor] [--set g_steps=200]
     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
     python -m experiments.train --config lip_cnn_indoor --export-only --export PATH   # the latest checkpoint
+    python -m experiments.train --config lip_cnn_indoor --export-only --average 4 --export PATH  # mean of 4
 
 A killed run resumes from its last checkpoint when started again with the same workdir. The run writes only into
 its workdir (checkpoints, metrics.jsonl, curves.png); the model is exported only to --export PATH.
@@ -23,6 +24,8 @@ def main(argv=None) -> None:
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", help="override a config field")
     p.add_argument("--export", default=None, help="model path stem to export to (default: no export)")
     p.add_argument("--export-only", action="store_true", help="export the latest checkpoint without training")
+    p.add_argument("--average", type=int, default=1, metavar="N",
+                   help="export the mean parameters of the newest N checkpoints (checkpoint averaging; default 1)")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
     if args.export_only and args.export is None:
@@ -36,7 +39,7 @@ def main(argv=None) -> None:
         raise SystemExit(2) from None
     enable_compilation_cache()
     run(config, args.workdir or f"runs/{args.config}", export=args.export, export_only=args.export_only,
-        progress=not args.no_progress)
+        average=args.average, progress=not args.no_progress)
 
 
 if __name__ == "__main__":

@@ -68,6 +68,26 @@ def test_smoke_run_goes_through_all_phases_logs_and_exports(straight_run, tmp_pa
     assert model(rgb, sparse).shape == (24, 32)
 
 
+def test_export_averages_the_newest_checkpoints(straight_run, tmp_path):
+    """`run(..., average=2)` exports the element-wise mean of G's parameters over the newest two checkpoints, with
+    their steps and the budget of the newest; more checkpoints than kept is a one-line error."""
+    from lipjax.train.run import run
+
+    workdir, _ = straight_run
+    manager = CheckpointManager(workdir / "checkpoints", keep=CONFIG.keep_checkpoints)
+    newest = sorted(manager.all_steps())[-2:]
+    trees = [manager.restore(init_state(CONFIG), step)[0].g_params for step in newest]
+    manager.close()
+    assert newest == [6, 8] and not _leaves_equal(*trees)  # two different parameter sets
+    run(CONFIG, workdir, export=tmp_path / "avg", export_only=True, average=2, progress=False)
+    model = lipjax.load_model(tmp_path / "avg")
+    for got, a, b in zip(*(jax.tree_util.tree_leaves(t) for t in (model.params, *trees))):
+        np.testing.assert_allclose(np.asarray(got), (np.asarray(a) + np.asarray(b)) / 2, rtol=1e-6, atol=1e-7)
+    assert model.metadata["checkpoints"] == [6, 8] and model.metadata["images_seen"] == 8 * CONFIG.batch_size
+    with pytest.raises(ValueError, match="holds 3 checkpoint"):
+        run(CONFIG, workdir, export=tmp_path / "avg9", export_only=True, average=9, progress=False)
+
+
 def test_discriminator_phase_keeps_generator_frozen(straight_run):
     workdir, _ = straight_run
     manager = CheckpointManager(workdir / "checkpoints")

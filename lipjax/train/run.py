@@ -9,6 +9,10 @@ from __future__ import annotations
 import json
 import os
 import pathlib
+from typing import Any
+
+import jax
+import numpy as np
 
 from lipjax import model_io
 from lipjax.train.checkpoint import CheckpointManager
@@ -38,13 +42,36 @@ def logged_validation(metrics_path: pathlib.Path, step: int) -> dict | None:
     return {k: v for k, v in found[-1].items() if k not in ("split", "step")} if found else None
 
 
+def averaged_params(config: TrainConfig, workdir: str | os.PathLike, count: int) -> tuple[Any, list[int]]:
+    """Checkpoint averaging: the element-wise mean of G's parameters over the newest `count` checkpoints of the
+    run in `workdir`, and their steps. Late in a decaying schedule the checkpoints lie close together, and their
+    mean is at least as good as the last one on validation (measured: README, lip-fast-indoor)."""
+    manager = CheckpointManager(pathlib.Path(workdir) / "checkpoints", keep=config.keep_checkpoints)
+    try:
+        steps = sorted(manager.all_steps())[-count:]
+        if len(steps) < count:
+            raise ValueError(f"--average {count}: {manager.directory} holds {len(steps)} checkpoint(s); average "
+                             f"fewer, or keep more while training (--set keep_checkpoints=N)")
+        init = model_io.load(config.init_from)[1] if config.init_from else None
+        template = init_state(config, init)
+        trees = [manager.restore(template, step)[0].g_params for step in steps]
+    finally:
+        manager.close()
+    mean = jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype), *trees)
+    return mean, steps
+
+
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
-        export_only: bool = False, progress: bool = True) -> dict:
+        export_only: bool = False, average: int = 1, progress: bool = True) -> dict:
     """Trains `config` in `workdir` (resuming), then validates and, when `export` is a path, saves the model there.
 
-    export_only: skip training and export the latest checkpoint. Returns the validation metrics (metres).
+    export_only: skip training and export the latest checkpoint. average: validate and export the mean
+    parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
+    metadata as `checkpoints`). Returns the validation metrics (metres).
     """
     workdir = pathlib.Path(workdir)
+    if average < 1:
+        raise ValueError(f"--average {average}: give a number of checkpoints >= 1")
     if export_only:
         manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
         if manager.latest_step() is None:
@@ -54,7 +81,13 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         manager.close()
     else:
         state = train(config, workdir, progress=progress)
-    val = logged_validation(workdir / "metrics.jsonl", int(state.step))
+    averaged = {}
+    if average > 1:
+        params, steps = averaged_params(config, workdir, average)
+        state, averaged = state.replace(g_params=params), {"checkpoints": steps}
+        val = evaluate_params(config.model, params, validation_batches(config), config.model.max_depth_m)
+    else:
+        val = logged_validation(workdir / "metrics.jsonl", int(state.step))
     if val is None:  # not evaluated at this step by the loop (e.g. --export-only of an older checkpoint)
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
     if (workdir / "metrics.jsonl").exists():
@@ -63,8 +96,9 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         d = config.data
         export_model(config, state, export, {"val_metrics": val, "val_sampler": d.val_sampler,
                                              "val_images": d.val_images, "data": d.kind if d.source == "synthetic"
-                                             else d.source})
-        print(f"[lipjax] exported {config.name} (step {int(state.step)}) to {export}: val rmse_m={val['rmse_m']:.4f}")
+                                             else d.source, **averaged})
+        what = f"mean of steps {averaged['checkpoints']}" if averaged else f"step {int(state.step)}"
+        print(f"[lipjax] exported {config.name} ({what}) to {export}: val rmse_m={val['rmse_m']:.4f}")
     else:
         print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f} "
               "(nothing exported; add --export PATH)")
