@@ -170,16 +170,16 @@ LIP_FAST_OUTDOOR = dataclasses.replace(
 # LIP+AD on the fast prox: D sees differences of log depth (Discriminator(inputs="log_gradients")): with depth /
 # max_depth, the paper's D stayed at chance (held-out accuracy 0.49-0.50 after 100 steps at lr 2e-4 or 1e-3, and
 # 4x wider); with log-depth differences it reached 0.76-0.89 (benchmarks/discriminator_probe.py --steps 100
-# --train 16 --val 8, G = lip-ad-indoor; 0.87-0.93 at 400 steps with --train 64 --val 32). The shipped
-# lip-ad-fast-indoor is this config from the shipped lip-fast-indoor (64,000 images), on the rendered frames (--set
+# --train 16 --val 8, G = lip-ad-indoor; 0.87-0.93 at 400 steps with --train 64 --val 32). The previous
+# lip-ad-fast-indoor was this config from the 64,000-image lip-fast-indoor, on the rendered frames (--set
 # data.source=rendered --set data.root=runs/data/indoor-train-256x320): D accuracy 0.67 after its 100 steps, 0.79 on
 # average over the 300 joint steps (0.90 at the end); validation RMSE 0.1729 / MAE 0.0652 m against 0.1742 / 0.0663
 # for lip-fast-indoor. At learning rate 2e-4 (the earlier setting) the same run ended worse than its start (0.1760 /
 # 0.0678): after a run whose cosine schedule has decayed to zero, the joint steps need a small learning rate.
 # The shipped lip-ad-fast-indoor (103,200 images) is this config from the 100,000-image lip-fast-indoor, exported as
-# the mean of its last 3 checkpoints (steps 200-400: `--init_from` that model, `--export-only --average 3`):
-# validation RMSE 0.1691 m against 0.1694 (its last checkpoint alone: 0.1699); D accuracy 0.60 after its 100 steps,
-# 0.77 on average over the joint steps.
+# the mean of its last 3 checkpoints (steps 200-400: `--set init_from=PATH` of that model, then `--export-only
+# --average 3`): validation RMSE 0.1691 m against 0.1694 (its last checkpoint alone: 0.1699, behind its start);
+# D accuracy 0.60 after its 100 steps, 0.77 on average over the joint steps.
 LIP_AD_FAST_INDOOR = dataclasses.replace(
     LIP_FAST_INDOOR, name="lip-ad-fast-indoor", init_from="lip-fast-indoor", g_steps=0, d_steps=100, adv_steps=300,
     learning_rate=5e-5, warmup_steps=20, adv_weight=1e-3,
