@@ -128,22 +128,23 @@ BASELINE_CONFIGS: dict[str, TrainConfig] = {
 
 # Scattered points plus LiDAR scan lines on the rooms (a 64-beam and a 16-beam pattern at 0.4 deg azimuth steps,
 # about 7,800 and 2,200 points on a 256x320 room): real sensors give either, and a prox trained on scan lines as
-# well beats linear interpolation on more real frames (README, "LiDAR scan lines on the rooms").
+# well beats linear interpolation on more real frames (README: Design notes, "Scan lines on rooms").
 FAST_INDOOR_SAMPLER = INDOOR_DATA.train_sampler + "|lidar:hdl64,azimuth_step_deg=0.4|lidar:vlp16,azimuth_step_deg=0.4"
 # The shared-encoder prox (lipjax.priors.guided): a third of the paper-style G's FLOPs per frame and ~2.7x its
 # train-step rate here, so it trains longer for the same CPU time. Started from the linear fill (identity-
 # initialised), L1 loss, zoom / flip / photometric / blur augmentation (lipjax.data.augment.DEFAULT_TRAINING).
-# The shipped lip-fast-indoor (64,000 images) is this config, trained in two runs on the 2-core CPU:
+# The shipped lip-fast-indoor (100,000 images) is this config, trained in three runs on the 2-core CPU:
 #     lipjax data render --kind indoor --split train --count 12000 --out runs/data/indoor-train-256x320
 #     python -m experiments.train --config lip_fast_indoor --set data.source=rendered \
 #         --set data.root=runs/data/indoor-train-256x320 --export lipjax/weights/lip-fast-indoor
 # (3,500 steps, 28,000 images, ~75 min; its first 1,000 steps at learning rate 1e-3, cosine over 8,000 steps, with
 # sample noise and outliers on, then resumed at step 1,000 with these settings), then continued from those weights
-# for 4,500 steps (36,000 images, ~80 min), validation RMSE 0.198 -> 0.174 m:
+# for 4,500 steps (36,000 images, ~80 min; scattered samples only, 64,000 images in all), validation RMSE
+# 0.198 -> 0.174 m (docs/training/lip-fast-indoor-to-64k.png):
 #     ... --set init_from=lip-fast-indoor --set g_steps=4500 --set learning_rate=3e-4 --set warmup_steps=200
-# (64,000 images, scattered samples only), then with LiDAR scan lines added to the rooms' samplers (FAST_INDOOR_SAMPLER,
-# now this config's) for 4,500 more steps (100,000 images, ~100 min), exported as the mean of its last 4 checkpoints,
-# validation RMSE 0.1742 -> 0.1694 m (docs/training/lip-fast-indoor.png):
+# then with LiDAR scan lines added to the rooms' samplers (FAST_INDOOR_SAMPLER, now this config's) for 4,500 more
+# steps (100,000 images in all, ~100 min), exported as the mean of its last 4 checkpoints, validation RMSE
+# 0.1742 -> 0.1694 m (docs/training/lip-fast-indoor.png):
 #     ... --set init_from=lip-fast-indoor --set g_steps=4500 --set learning_rate=1e-4 --set warmup_steps=100 \
 #         --set checkpoint_every=250 --set keep_checkpoints=40 --set data.num_workers=1 --set eval_every=500
 #     python -m experiments.train ...the same... --export-only --average 4 --export lipjax/weights/lip-fast-indoor
