@@ -142,6 +142,7 @@ FAST_INDOOR_SAMPLER = INDOOR_DATA.train_sampler + "|lidar:hdl64,azimuth_step_deg
 # for 4,500 steps (36,000 images, ~80 min; scattered samples only, 64,000 images in all), validation RMSE
 # 0.198 -> 0.174 m (docs/training/lip-fast-indoor-to-64k.png):
 #     ... --set init_from=lip-fast-indoor --set g_steps=4500 --set learning_rate=3e-4 --set warmup_steps=200
+# (both runs with INDOOR_DATA's scattered samplers: add --set "data.train_sampler=..." to repeat them exactly),
 # then with LiDAR scan lines added to the rooms' samplers (FAST_INDOOR_SAMPLER, now this config's) for 4,500 more
 # steps (100,000 images in all, ~100 min), exported as the mean of its last 4 checkpoints, validation RMSE
 # 0.1742 -> 0.1694 m (docs/training/lip-fast-indoor.png):
