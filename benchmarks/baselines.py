@@ -41,6 +41,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
+from lipjax.data import protocols  # noqa: E402
 from lipjax.methods import get_method  # noqa: E402
 from lipjax.classical.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
@@ -110,6 +111,14 @@ def load_middlebury(root: str) -> list[Sample]:
     rgb = _rgb(os.path.join(root, "im0.png"))
     return [Sample.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy),
                               "realdata/middlebury/motorcycle")]
+
+
+def load_real(root: str) -> tuple[list[Sample], list[Sample], list[Sample]]:
+    """The real frames under `root` as the benchmarks score them: NYU v2 (protocol nyu_paper), KITTI (kitti_paper),
+    Middlebury (full size)."""
+    nyu = [protocols.NYU_PAPER(s) for s in load_nyu(os.path.join(root, "nyu_v2"))]
+    kitti = [protocols.KITTI_PAPER(s) for s in load_kitti(os.path.join(root, "kitti"))]
+    return nyu, kitti, load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
 
 
 # ------------------------------------------------------------------------------------------- runner
@@ -195,7 +204,6 @@ def main(argv=None) -> None:
         methods = [Downsized(m, args.max_side) for m in methods]
     print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIPWavelet()}")
 
-    from lipjax.data import protocols
     from lipjax.data.sampling import LidarSampler, UniformSampler
 
     settings = []
@@ -211,9 +219,7 @@ def main(argv=None) -> None:
         ]
     root = os.path.abspath(args.realdata)
     if not args.skip_real and os.path.isdir(root):
-        nyu = [protocols.NYU_PAPER(s) for s in load_nyu(os.path.join(root, "nyu_v2"))]
-        kitti = [protocols.KITTI_PAPER(s) for s in load_kitti(os.path.join(root, "kitti"))]
-        mb = load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
+        nyu, kitti, mb = load_real(root)
         settings += [
             Setting("real NYU v2 (3 frames, nyu_paper 256x320), 200 uniform points", nyu, UniformSampler(200),
                     INDOOR_RANGE_M),

@@ -26,27 +26,25 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
-from baselines import load_kitti, load_middlebury, load_nyu  # noqa: E402
+from baselines import INDOOR_RANGE_M, OUTDOOR_RANGE_M, load_real  # noqa: E402
 from lipjax import model_io  # noqa: E402
-from lipjax.data import protocols  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.evaluate import evaluate  # noqa: E402
 from lipjax.methods import get_method  # noqa: E402
 
 
-def real_settings(root: str) -> list[tuple[list, object, float]]:
-    """(frames, sampler, max depth m) of the three main real settings."""
-    nyu = [protocols.NYU_PAPER(s) for s in load_nyu(os.path.join(root, "nyu_v2"))]
-    kitti = [protocols.KITTI_PAPER(s) for s in load_kitti(os.path.join(root, "kitti"))]
-    mb = load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
-    return [(nyu, UniformSampler(200), 10.0), (kitti, LidarSampler.hdl64(), 80.0), (mb, UniformSampler(200), 10.0)]
+def real_settings(root: str) -> list[tuple[list, object, tuple[float, float]]]:
+    """(frames, sampler, depth range m) of the three main real settings of benchmarks/baselines.py."""
+    nyu, kitti, mb = load_real(root)
+    return [(nyu, UniformSampler(200), INDOOR_RANGE_M), (kitti, LidarSampler.hdl64(), OUTDOOR_RANGE_M),
+            (mb, UniformSampler(200), INDOOR_RANGE_M)]
 
 
 def frame_rmse(method, settings) -> dict[str, float]:
     """RMSE (m) of `method` on every frame of `settings`, by frame id."""
     out = {}
-    for frames, sampler, max_depth in settings:
-        result = evaluate(method, frames, sampler, min_depth_m=0.0, max_depth_m=max_depth, progress=False)
+    for frames, sampler, (min_depth, max_depth) in settings:
+        result = evaluate(method, frames, sampler, min_depth_m=min_depth, max_depth_m=max_depth, progress=False)
         out.update({row["id"]: row["rmse_m"] for row in result.per_image})
     return out
 

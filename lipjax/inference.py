@@ -87,11 +87,14 @@ class Completer:
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)
 
-    @property
+    @functools.cached_property  # read on every call: the spec is parsed once
     def scan_lines_trained(self) -> bool:
         """Whether the model's training input included LiDAR scan lines (its metadata's `train_sampler`, a
-        lipjax.data.sampling spec, recorded at export)."""
-        return "lidar:" in str(self.metadata.get("train_sampler", ""))
+        lipjax.data.sampling spec, recorded at export; older models record none)."""
+        from lipjax.data.sampling import draws_scan_lines
+
+        spec = self.metadata.get("train_sampler")
+        return spec is not None and draws_scan_lines(spec)
 
 
 def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:

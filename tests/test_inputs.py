@@ -87,6 +87,9 @@ def test_scan_lines_are_no_warning_for_an_indoor_model_trained_on_them():
     scattered = inference.Completer.random()
     lidar = dataclasses.replace(scattered, metadata={"train_sampler": "uniform:200|lidar:hdl64,azimuth_step_deg=0.4"})
     assert lidar.scan_lines_trained and not scattered.scan_lines_trained
+    noisy = dataclasses.replace(scattered, metadata={"train_sampler": "uniform:200|lidar:vlp16+noise:std=0.02"})
+    points = dataclasses.replace(scattered, metadata={"train_sampler": "uniform:200|bernoulli:100"})
+    assert noisy.scan_lines_trained and not points.scan_lines_trained
 
 
 def test_far_too_few_samples_warn():

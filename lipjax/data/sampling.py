@@ -320,6 +320,13 @@ def sampler_from_spec(spec: str) -> SparseSampler:
     return _single_sampler_from_spec(spec)
 
 
+def draws_scan_lines(spec: str) -> bool:
+    """Whether the sampler of `spec` (see `sampler_from_spec`) draws LiDAR scan lines for some examples."""
+    sampler = sampler_from_spec(spec)
+    parts = sampler.samplers if isinstance(sampler, Mixture) else (sampler,)
+    return any(isinstance(part.sampler if isinstance(part, Noisy) else part, LidarSampler) for part in parts)
+
+
 def _single_sampler_from_spec(spec: str) -> SparseSampler:
     """Builds a sampler from a string.
 

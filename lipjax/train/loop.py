@@ -86,30 +86,24 @@ def _initial_g_params(config: TrainConfig):
     return params
 
 
-class _Stop:
-    """What SIGTERM (kill, a scheduler's stop, a preemption notice) asked of a training run."""
-
-    def __init__(self):
-        self.requested = False
-
-
 @contextlib.contextmanager
 def _sigterm_as_exit(save_first: bool):
     """SIGTERM ends a training run with SystemExit(143) so that the `finally` blocks run: the loader's worker
     processes stop with the run instead of outliving it; started again, the run resumes.
 
-    save_first (a single-process run): the first SIGTERM only sets `requested`; the loop then finishes the step
-    it is in, saves a checkpoint of it and exits, so a preempted run loses no step. A second SIGTERM exits at
-    once (the last saved checkpoint is kept). A multi-process run exits at once: a checkpoint is a collective
-    write that every process would have to reach at the same step. No-op outside the main thread."""
-    stop = _Stop()
+    Yields a threading.Event. save_first (a single-process run): the first SIGTERM only sets it; the loop then
+    finishes the step it is in, saves a checkpoint of it and exits, so a preempted run loses no step. A second
+    SIGTERM exits at once (the last saved checkpoint is kept). A multi-process run exits at once: a checkpoint
+    is a collective write that every process would have to reach at the same step. No-op outside the main
+    thread."""
+    stop = threading.Event()
     if threading.current_thread() is not threading.main_thread():
         yield stop
         return
 
     def on_sigterm(signum, frame):
-        if save_first and not stop.requested:
-            stop.requested = True
+        if save_first and not stop.is_set():
+            stop.set()
             return
         raise SystemExit(128 + signum)
 
@@ -204,10 +198,10 @@ def train(
                     if log:
                         log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
                         log.flush()
-                if done % config.checkpoint_every == 0 or done == end or stop.requested:
+                if done % config.checkpoint_every == 0 or done == end or stop.is_set():
                     manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
                                                "data_loader": loader.state()})
-                if stop.requested and done < end:
+                if stop.is_set() and done < end:
                     bar.write(f"[lipjax] SIGTERM: saved step {done} in {manager.directory}; stopping (run again to "
                               "resume)")
                     raise SystemExit(128 + signal.SIGTERM)

@@ -42,18 +42,18 @@ def logged_validation(metrics_path: pathlib.Path, step: int) -> dict | None:
     return {k: v for k, v in found[-1].items() if k not in ("split", "step")} if found else None
 
 
-def averaged_params(config: TrainConfig, workdir: str | os.PathLike, count: int) -> tuple[Any, list[int]]:
+def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: Any,
+                    count: int) -> tuple[Any, list[int]]:
     """Checkpoint averaging: the element-wise mean of G's parameters over the newest `count` checkpoints of the
-    run in `workdir`, and their steps. Late in a decaying schedule the checkpoints lie close together, and their
-    mean is at least as good as the last one on validation (measured: README, lip-fast-indoor)."""
+    run in `workdir` (restored into `template`, a TrainState of the run's structure), and their steps. Late in a
+    decaying schedule the checkpoints lie close together, and their mean is at least as good as the last one on
+    validation (measured: README, lip-fast-indoor)."""
     manager = CheckpointManager(pathlib.Path(workdir) / "checkpoints", keep=config.keep_checkpoints)
     try:
         steps = sorted(manager.all_steps())[-count:]
         if len(steps) < count:
             raise ValueError(f"--average {count}: {manager.directory} holds {len(steps)} checkpoint(s); average "
                              f"fewer, or keep more while training (--set keep_checkpoints=N)")
-        init = model_io.load(config.init_from)[1] if config.init_from else None
-        template = init_state(config, init)
         trees = [manager.restore(template, step)[0].g_params for step in steps]
     finally:
         manager.close()
@@ -83,7 +83,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         state = train(config, workdir, progress=progress)
     averaged = {}
     if average > 1:
-        params, steps = averaged_params(config, workdir, average)
+        params, steps = averaged_params(config, workdir, jax.device_get(state), average)
         state, averaged = state.replace(g_params=params), {"checkpoints": steps}
         val = evaluate_params(config.model, params, validation_batches(config), config.model.max_depth_m)
     else:
