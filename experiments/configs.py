@@ -197,6 +197,27 @@ LIP_AD_FAST_OUTDOOR = dataclasses.replace(
     discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M, inputs="log_gradients"),
 )
 
+# lip-any: one model for rooms and streets, any sensor (issue 22). The shared-encoder prox (its network never sees a
+# metric depth: log depth relative to the frame's own samples) from the shipped lip-fast-indoor, trained on rooms and
+# streets interleaved (data.kind="mixed", both rendered at 256x320), each frame's error in units of its own sample
+# scale (loss_scale="samples"), from 50 to 5,000 scattered points, 16- to 64-beam scans at random mount pitch, noise
+# and bleed-through outliers on some, and colour texture without depth edges (augment.texture_prob). Its initial
+# estimate is the linear fill, the reference it has to beat everywhere.
+ANY_SAMPLER = "|".join((
+    "uniform:50", "uniform:200", "uniform:200", "uniform:500", "uniform:1000", "uniform:5000", "bernoulli:2000",
+    "uniform:300+noise:rel=0.01,outliers=0.03",
+    "lidar:hdl64,azimuth_step_deg=0.4", "lidar:vlp32,azimuth_step_deg=0.3,mount_pitch_deg=-3",
+    "lidar:vlp16,azimuth_step_deg=0.4,mount_pitch_deg=2", "lidar:hdl64+noise:rel=0.005,outliers=0.02",
+))
+ANY_AUGMENT = dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.6, 1.6), texture_prob=0.3)
+LIP_ANY = dataclasses.replace(
+    LIP_FAST_INDOOR, name="lip-any", model=_fast_model(OUTDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE),
+    data=dataclasses.replace(INDOOR_DATA, kind="mixed", augment=ANY_AUGMENT, train_sampler=ANY_SAMPLER,
+                             val_sampler="uniform:200|lidar:hdl64", val_images=32),
+    loss_scale="samples", init_from="lip-fast-indoor", g_steps=4000, learning_rate=2e-4, warmup_steps=100,
+    eval_every=500, checkpoint_every=250, keep_checkpoints=40,
+)
+
 # ---- The paper's data sets and your own (lipjax.data.sources). Each run reads its frames from --set data.root=DIR:
 #     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
 # Runtimes on one GPU are ESTIMATES, not measurements: no GPU was lent to the session that wrote these configs.
@@ -286,6 +307,7 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_fast_outdoor": LIP_FAST_OUTDOOR,
     "lip_ad_fast_indoor": LIP_AD_FAST_INDOOR,
     "lip_ad_fast_outdoor": LIP_AD_FAST_OUTDOOR,
+    "lip_any": LIP_ANY,
     "smoke": SMOKE,
     **BASELINE_CONFIGS,
     "lip_cnn_nyu": LIP_CNN_NYU,

@@ -123,9 +123,11 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
     source, root = data.source, data.root
     if source == "synthetic":
-        from lipjax.data.synthetic import SyntheticDataset
+        from lipjax.data.synthetic.dataset import MIXED_KIND, MixedSyntheticDataset, SyntheticDataset
 
         size = data.val_images if split == "val" else None
+        if data.kind == MIXED_KIND:
+            return MixedSyntheticDataset(split, size=size, height=data.height, width=data.width), None
         return SyntheticDataset(data.kind, split, size=size, height=data.height, width=data.width), None
     if root is None:
         raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")
@@ -195,7 +197,7 @@ def range_protocol(data: Any) -> Protocol | None:
     they are, data.protocol="none") the source's default, synthetic_<data.kind> for the synthetic scenes; None for
     a folder."""
     if data.source in ("synthetic", "rendered"):
-        default = f"synthetic_{data.kind}"
+        default = "synthetic_outdoor" if data.kind == "mixed" else f"synthetic_{data.kind}"  # 0-80 m holds both
     else:
         default = DEFAULT_PROTOCOLS.get(data.source)
     return applied_protocol(data) or (get_protocol(default) if default else None)

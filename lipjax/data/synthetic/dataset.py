@@ -185,3 +185,36 @@ class SyntheticDataset:
     def __repr__(self) -> str:
         return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
                 f"width={self.width})")
+
+
+MIXED_KIND = "mixed"
+
+
+class MixedSyntheticDataset:
+    """Rooms and streets interleaved, for one model of both: dataset[2 i] == render("indoor", split, i, H, W),
+    dataset[2 i + 1] == render("outdoor", split, i, H, W).
+
+    Both kinds are rendered at the same height x width (so that they batch together); the outdoor camera keeps
+    KITTI's vertical field of view (`intrinsics_for`). Sample ids are the per-kind ones, so a sampler draws the same
+    points from a frame here as from the single-kind set.
+    """
+
+    kind = MIXED_KIND
+
+    def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH):
+        self.parts = tuple(SyntheticDataset(kind, split, None, height, width) for kind in SYNTHETIC_KINDS)
+        self.split, self.height, self.width = split, *_check_size(height, width)
+        self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
+
+    def __len__(self) -> int:
+        return self.size
+
+    def __getitem__(self, index: int) -> Sample:
+        index = _check_index(index)
+        if index >= self.size:
+            raise _IndexOutOfRange(f"index {index} out of range for MixedSyntheticDataset({self.split!r}) of size "
+                                   f"{self.size}")
+        return self.parts[index % 2][index // 2]
+
+    def __repr__(self) -> str:
+        return f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width})"
