@@ -39,13 +39,12 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
   --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
             in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
 
-Image size: any. The model is fully convolutional and runs at the input resolution (the network pads to a
-multiple of 8 internally); a new size costs one compilation. `--max-side N` runs frames whose longer side
-exceeds N at a reduced size for speed: the RGB is area-resized; each measured depth pixel is moved to the
+Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
+in training (lipjax.resolution: 200 points on 640x480 run at about half size; a 64-beam scan at full size); a new
+size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
 pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are
-never averaged); the result is resized back (bilinear) and the measured pixels are then set to their
-measured values exactly. Without --max-side the output is the model's own (its x-update pulls measured pixels
-towards the measurements, paper eq. 6).
+never averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured
+values exactly. `--max-side N` overrides the working size: the longer side becomes at most N pixels.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
@@ -113,7 +112,7 @@ def _model_max_depth(completer) -> float:
 
 def _cmd_complete(args) -> int:
     from lipjax.data.folder import check_one_depth_format, output_format, pair_frames, read_frame, write_depth
-    from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, get_completer
+    from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, frame_size, get_completer
     from lipjax.pointcloud import backproject_rgbd, write_ply
     from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
 
@@ -159,7 +158,8 @@ def _cmd_complete(args) -> int:
         if completer is None:
             completer = get_completer(args.model, args.iterations, sparse=sparse)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
-            if args.max_side is None and sparse.size > LARGE_FRAME_PIXELS:
+            h, w = frame_size(completer, sparse, args.max_side)
+            if args.max_side is None and h * w > LARGE_FRAME_PIXELS:
                 _warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) runs "
                       "slowly and needs gigabytes at full size; --max-side 1024 runs it downsized (--max-side 416 "
                       "with the shipped outdoor models, their training scale)")
@@ -382,7 +382,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, default=None, help="per-frame format with folder inputs")
     c.add_argument("--max-side", type=console.positive_int, default=None, metavar="N",
-                   help="run larger frames downsized to this longer side")
+                   help="run frames downsized to this longer side (default: the working size of the samples)")
     c.add_argument("--color-range", type=float, nargs=2, default=None, metavar=("MIN_M", "MAX_M"),
                    help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
     c.add_argument("--ply", default=None, help="also write a coloured point cloud (.ply; a folder with folder inputs)")

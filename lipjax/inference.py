@@ -23,6 +23,7 @@ from lipjax import model_io
 from lipjax.inputs import DEFAULT_MODELS, InputError, check_inputs, suggest_scene  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import LearnedModel
 from lipjax.model import LIPConfig
+from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
 from lipjax.zbuffer import splat_nearest
 
 DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
@@ -141,10 +142,15 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_unce
 
     `model`: a completer, a shipped model name, a saved model path or any `lipjax.methods` name ("linear",
     "ip_basic", ...); by default the shipped default model, indoor or outdoor as the samples suggest
-    (`get_completer`). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
+    (`get_completer`). A learned model runs at the working size of the samples' spacing (`complete_frame`). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
     (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
     """
-    dense = get_completer(model, sparse=sparse)(rgb, sparse)
+    completer = get_completer(model, sparse=sparse)
+    rgb, sparse = np.asarray(rgb), np.asarray(sparse, np.float32)
+    if sparse.ndim == 3:
+        dense = np.stack([complete_frame(completer, c, y) for c, y in zip(rgb, sparse)])
+    else:
+        dense = complete_frame(completer, rgb, sparse)
     if max_uncertainty is None and not return_uncertainty:
         return dense
     from lipjax.uncertainty import drop_uncertain, expected_error
@@ -174,23 +180,57 @@ def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return splat_nearest(r * w + c, sparse[rows, cols], (h, w))
 
 
-def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
-    """Dense (H, W) float32 metres for one frame.
+def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> tuple[int, int]:
+    """(h, w) at which `completer` runs on a frame with (H, W) sparse depth `sparse_m` (metres, 0 = none).
 
-    With `max_side` and a longer side above it, the model runs at a reduced size whose longer side is max_side:
-    the RGB is area-resized, the samples are moved onto the small grid (`reproject_sparse`), the result is
-    resized back (bilinear), and the measured pixels are set back to their measured values exactly.
+    `max_side` (pixels, >= MIN_MAX_SIDE_PX) caps the longer side; without it a learned model runs at the
+    working size of its samples' spacing (`lipjax.resolution.working_size`) and a classical fill at full size.
+    """
+    shape = tuple(np.shape(sparse_m))
+    if max_side is not None:
+        if max_side < MIN_MAX_SIDE_PX:
+            raise InputError(f"max_side {max_side}: too small to hold a depth map; use at least {MIN_MAX_SIDE_PX} "
+                             "pixels (or none: the working size then follows the samples)")
+        return max_side_size(shape, max_side)
+    if not isinstance(completer, Completer):
+        return shape
+    spacing = sample_spacing_px(sparse_m)
+    return shape if spacing == float("inf") else working_size(shape, spacing)
+
+
+def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
+    """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`)."""
+    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side))
+
+
+def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int],
+                upsample: str = "bilinear") -> np.ndarray:
+    """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
+
+    Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
+    estimate z (h, w) comes back to full size, by `upsample`:
+      "bilinear": bilinear(z);
+      "residual": F * bilinear(z / f), with F the linear fill at full size and f the one at the working size: the
+        prox's learned correction is carried over to the full-size fill, which keeps its detail near the samples.
+    Then the final x-update runs at full size: with rho -> 0 at the measured pixels (m = 1),
+    x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value exactly.
     """
     import cv2
 
     big_h, big_w = sparse_m.shape
-    if max_side is None or max(big_h, big_w) <= max_side:
+    h, w = size
+    if (h, w) == (big_h, big_w):
         return np.asarray(completer(rgb, sparse_m), np.float32)
-    s = max_side / max(big_h, big_w)
-    h, w = max(1, round(big_h * s)), max(1, round(big_w * s))
     small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
-    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    small_sparse = reproject_sparse(sparse_m, (h, w))
+    small = np.asarray(completer(small_rgb, small_sparse), np.float32)
+    if upsample == "residual":
+        from lipjax.classical.interpolate import linear_fill
+
+        ratio = small / np.maximum(linear_fill(small_sparse), 1e-3)
+        dense = linear_fill(sparse_m) * cv2.resize(ratio, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    else:
+        dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
     return dense.astype(np.float32)

@@ -1,0 +1,91 @@
+"""The working resolution of a learned prox (lipjax.resolution) and the full-size output (inference.complete_at)."""
+import math
+
+import numpy as np
+import pytest
+
+from lipjax import inference
+from lipjax.classical.interpolate import linear_fill
+from lipjax.resolution import (
+    MIN_SCALE_CHANGE,
+    MIN_WORKING_SIDE_PX,
+    TARGET_SPACING_PX,
+    max_side_size,
+    sample_spacing_px,
+    working_size,
+)
+
+
+def _sparse(h, w, n, seed=0):
+    rng = np.random.default_rng(seed)
+    out = np.zeros((h, w), np.float32)
+    idx = rng.choice(h * w, n, replace=False)
+    out.reshape(-1)[idx] = rng.uniform(1.0, 5.0, n)
+    return out
+
+
+def test_sample_spacing_is_sqrt_of_pixels_per_sample():
+    assert sample_spacing_px(_sparse(480, 640, 200)) == pytest.approx(math.sqrt(480 * 640 / 200))
+    assert sample_spacing_px(np.zeros((4, 4))) == math.inf
+
+
+def test_working_size_puts_the_samples_at_the_target_spacing():
+    spacing = math.sqrt(480 * 640 / 200)  # 39.2 px
+    h, w = working_size((480, 640), spacing)
+    s = TARGET_SPACING_PX / spacing
+    assert (h, w) == (round(480 * s), round(640 * s))
+    # at the working size the n samples lie TARGET_SPACING_PX apart (up to rounding)
+    assert math.sqrt(h * w / 200) == pytest.approx(TARGET_SPACING_PX, rel=0.01)
+
+
+def test_dense_samples_and_small_frames_run_at_full_size():
+    assert working_size((352, 1216), 4.7) == (352, 1216)  # a 64-beam scan: denser than the target
+    s = MIN_SCALE_CHANGE + 0.01
+    assert working_size((300, 400), TARGET_SPACING_PX / s) == (300, 400)  # a resize would not pay
+    # never below MIN_WORKING_SIDE_PX on the shorter side, however sparse
+    assert min(working_size((480, 640), 1000.0)) == MIN_WORKING_SIDE_PX
+    with pytest.raises(ValueError, match="spacing_px"):
+        working_size((10, 10), 0.0)
+
+
+def test_max_side_size_keeps_the_aspect():
+    assert max_side_size((480, 640), 320) == (240, 320)
+    assert max_side_size((100, 50), 320) == (100, 50)
+
+
+class _LinearAtAnySize:
+    """A stand-in learned model: the linear fill of whatever it is given."""
+
+    name = "linear-stand-in"
+
+    def __call__(self, rgb, sparse):
+        return linear_fill(sparse)
+
+
+def test_residual_upsampling_of_an_exact_fill_returns_the_full_size_fill():
+    # F * bilinear(z / f) with z = f (the model adds nothing) is F itself: the full-size fill, detail intact
+    sparse = _sparse(48, 64, 60, seed=1)
+    rgb = np.zeros((48, 64, 3), np.uint8)
+    out = inference.complete_at(_LinearAtAnySize(), rgb, sparse, (24, 32), upsample="residual")
+    np.testing.assert_allclose(out, linear_fill(sparse), rtol=1e-5)
+
+
+def test_complete_at_keeps_every_measured_pixel():
+    sparse = _sparse(48, 64, 60, seed=2)
+    rgb = np.zeros((48, 64, 3), np.uint8)
+    for upsample in ("bilinear", "residual"):
+        out = inference.complete_at(_LinearAtAnySize(), rgb, sparse, (20, 27), upsample=upsample)
+        assert out.shape == (48, 64) and out.dtype == np.float32
+        np.testing.assert_array_equal(out[sparse > 0], sparse[sparse > 0])
+
+
+def test_frame_size_follows_the_samples_for_learned_models_only():
+    sparse = _sparse(240, 320, 50)
+    model = inference.Completer.random()
+    h, w = inference.frame_size(model, sparse)
+    assert (h, w) == working_size((240, 320), sample_spacing_px(sparse))
+    assert (h, w) != (240, 320)
+    assert inference.frame_size(inference.get_completer("linear"), sparse) == (240, 320)
+    assert inference.frame_size(model, sparse, max_side=160) == (120, 160)
+    with pytest.raises(inference.InputError, match="max_side 3"):
+        inference.frame_size(model, sparse, max_side=3)
