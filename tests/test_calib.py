@@ -167,3 +167,50 @@ def test_calibration_mistakes_are_named(tmp_path):
     np.save(tmp_path / "behind.npy", np.array([[-5.0, 0, 0]]))
     with pytest.raises(ValueError, match="none of its 1 points lands in the 120x40 image"):
         project_sweep(tmp_path / "behind.npy", tmp_path / "calib.txt", (H, W))
+
+
+def test_intrinsics_files_take_calibration_files_and_a_bare_p(tmp_path):
+    """`--intrinsics-file` (read_intrinsics_txt): a KITTI calib file (image_2 by default, or --camera), a bare 3x4
+    P; 16 numbers are a one-line error that names the accepted contents."""
+    from lipjax.data.folder import read_intrinsics_txt
+
+    (tmp_path / "p2.txt").write_text(_numbers(P[2]))
+    (tmp_path / "t.txt").write_text(_numbers(np.eye(4)))
+    obj = write_object_calib(tmp_path / "calib.txt")
+    for path in (obj, tmp_path / "p2.txt"):
+        assert read_intrinsics_txt(path).as_matrix().tolist() == K.tolist()
+    assert read_intrinsics_txt(obj, camera=3).as_matrix().tolist() == K.tolist()
+    with pytest.raises(DatasetError, match="found 16 numbers") as info:
+        read_intrinsics_txt(tmp_path / "t.txt")
+    assert "calibration file (P2: ..." in str(info.value)
+
+
+def test_project_command_writes_the_sparse_image(tmp_path, capsys):
+    """`lipjax project`: .npy equal to project_sweep's, .png at KITTI's 256 per metre, a one-line summary (none
+    with -q); a depth PNG given as the image is a one-line error."""
+    import cv2
+
+    from lipjax import cli
+
+    rng = np.random.default_rng(1)
+    cam2 = np.stack([rng.uniform(-2, 2, 300), rng.uniform(-0.5, 0.5, 300), rng.uniform(5, 30, 300), np.ones(300)])
+    sweep = np.c_[(np.linalg.inv(_cam_from_velo(2)) @ cam2)[:3].T, rng.random(300)].astype(np.float32)
+    sweep.tofile(tmp_path / "000000.bin")
+    calib = write_object_calib(tmp_path / "calib.txt")
+    cv2.imwrite(str(tmp_path / "image.png"), np.full((H, W, 3), 90, np.uint8))
+    args = ["project", "--lidar", str(tmp_path / "000000.bin"), "--calib", str(calib), "--rgb",
+            str(tmp_path / "image.png")]
+    assert cli.main(args + ["--out", str(tmp_path / "sparse.npy")]) == 0
+    expected, _ = project_sweep(tmp_path / "000000.bin", calib, (H, W))
+    np.testing.assert_array_equal(np.load(tmp_path / "sparse.npy"), expected)
+    n = int((expected > 0).sum())
+    line = capsys.readouterr().err.strip()
+    assert line == (f"wrote {tmp_path / 'sparse.npy'}: depth at {n} pixels ({100 * n / (H * W):.1f} % of {W}x{H}), "
+                    f"{expected[expected > 0].min():.2f} to {expected.max():.2f} m")
+    assert cli.main(args + ["--out", str(tmp_path / "sparse.png"), "-q"]) == 0
+    raw = cv2.imread(str(tmp_path / "sparse.png"), cv2.IMREAD_UNCHANGED)
+    assert raw.dtype == np.uint16 and capsys.readouterr().err == ""
+    np.testing.assert_array_equal(raw, np.round(expected.astype(np.float64) * 256).astype(np.uint16))
+    assert cli.main(args[:-1] + [str(tmp_path / "sparse.png"), "--out", str(tmp_path / "x.npy")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("lipjax: error: A 16-bit single-channel PNG is a depth map") and err.count("\n") == 1
