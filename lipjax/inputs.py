@@ -135,7 +135,7 @@ def scene_reason(sparse: np.ndarray) -> tuple[str, str]:
     if median > OUTDOOR_MEDIAN_M:
         return "outdoor", f"median sample depth {median:.1f} m, over {OUTDOOR_MEDIAN_M:g} m"
     if any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:])):
-        return "outdoor", f"samples in LiDAR scan lines (median depth {median:.1f} m)"
+        return "outdoor", f"samples in LiDAR scan lines, median depth {median:.1f} m"
     return "indoor", f"scattered samples, median depth {median:.1f} m"
 
 
