@@ -126,8 +126,10 @@ def _cmd_complete(args) -> int:
     from lipjax.pointcloud import backproject_rgbd, write_ply
     from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
 
-    if (args.depth is None) == (args.lidar is None) or (args.lidar is None) != (args.calib is None):
+    if (args.depth is None) == (args.lidar is None):
         raise CLIError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
+    if (args.lidar is None) != (args.calib is None):
+        raise CLIError("--lidar SWEEP and --calib FILE go together: the sweep, and its calibration with the camera")
     rgb_path, out, ply = Path(args.rgb), Path(args.out), args.ply and Path(args.ply)
     depth_path = Path(args.depth or args.lidar)
     if args.lidar and rgb_path.is_dir():

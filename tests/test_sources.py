@@ -360,18 +360,18 @@ def test_lipjax_train_checks_its_output_folder_and_every_frame_before_training(t
     assert cli.main(args + ["--out", str(tmp_path / "blocker" / "model")]) == 1
     lines = capsys.readouterr().err.strip().splitlines()
     assert lines == [f"lipjax: error: cannot write the model (--out / --export) into {tmp_path / 'blocker'} "
-                     "(File exists); choose a writable folder"]
+                     f"({tmp_path / 'blocker'}: a file, not a folder); choose a writable folder"]
     assert check_frames(dataclasses.replace(CONFIG.data, source="folder", root=str(root), depth_scale=1000)) == 6
     (root / "rgb" / "0001.png").write_bytes(b"not a png")
     (root / "depth" / "0004.png").write_bytes((root / "depth" / "0004.png").read_bytes()[:60])
     (root / "sparse" / "0002.png").write_bytes(b"")
-    assert cli.main(args + ["--out", str(tmp_path / "model"), "--sampler", "input"]) == 1
+    assert cli.main(args + ["--out", str(tmp_path / "model" / "mine"), "--sampler", "input"]) == 1
     lines = capsys.readouterr().err.strip().splitlines()
     assert lines == [f"lipjax: error: 3 unreadable file(s) in {root}, checked before training: Cannot read RGB image "
                      "(missing, corrupt or unsupported format): rgb/0001.png; Cannot read depth PNG (missing, "
                      "corrupt or not an image): depth/0004.png; Cannot read depth PNG (missing, corrupt or not an "
                      "image): sparse/0002.png; fix or remove them (with their partner files)"]
-    assert not (tmp_path / "run").exists()
+    assert not (tmp_path / "run").exists() and not (tmp_path / "model").exists()
 
 
 def test_lipjax_data_render_command(tmp_path, capsys):

@@ -33,15 +33,13 @@ from lipjax.data.errors import dataset_error
 from lipjax.data.sample import Intrinsics
 from lipjax.pointcloud import as_intrinsics
 
-FORMATS = """\
-KITTI object/tracking calib .txt (P2, R0_rect, Tr_velo_to_cam)
-KITTI raw date folder (calib_velo_to_cam.txt + calib_cam_to_cam.txt)
-KITTI odometry calib.txt (P2, Tr)
-any rig, .txt or .yaml: K (9 numbers) or intrinsics (fx fy cx cy), and T_cam_from_lidar (12 or 16 numbers)"""
+FORMATS = ("a KITTI object/tracking calib .txt (P2, R0_rect, Tr_velo_to_cam), a KITTI raw date folder "
+           "(calib_velo_to_cam.txt + calib_cam_to_cam.txt), a KITTI odometry calib.txt (P2, Tr), or a rig .txt/.yaml "
+           "with K (9 numbers) or intrinsics (fx fy cx cy) and T_cam_from_lidar (12 or 16 numbers)")
 RAW_FILES = ("calib_velo_to_cam.txt", "calib_cam_to_cam.txt")
 
 
-def read_key_values(path: str | os.PathLike, layout: str = FORMATS, source: str = "") -> dict[str, np.ndarray]:
+def read_key_values(path: str | os.PathLike, layout: str = "", source: str = "") -> dict[str, np.ndarray]:
     """{key: float64 numbers} of a "key: n n n ..." text file; the colon may be missing (KITTI tracking:
     "R_rect 1 0 0 ..."); lines whose values are not all numbers (e.g. "calib_time: 09-Jan-2012") are skipped.
     An unreadable file raises DatasetError with `layout` and `source` (lipjax.data.errors)."""
@@ -92,8 +90,7 @@ def _need(rows: dict, path, *keys_and_sizes: tuple[tuple[str, ...], tuple[int, .
         key = next((k for k in keys if k in rows), None)
         if key is None or rows[key].size not in sizes:
             what = f"{rows[key].size} numbers in {key}" if key else f"no {' or '.join(keys)}"
-            raise dataset_error(f"Calibration has {what} (expected {' or '.join(map(str, sizes))} numbers)", path,
-                                FORMATS)
+            raise dataset_error(f"Calibration has {what} (expected {' or '.join(map(str, sizes))} numbers)", path)
         found.append(rows[key])
     return found
 
@@ -102,7 +99,7 @@ def _with_offset(p: np.ndarray, cam0_from_lidar: np.ndarray, path) -> tuple[Intr
     try:
         intrinsics, t = camera_from_projection(p)
     except ValueError as exc:
-        raise dataset_error(str(exc), path, FORMATS) from None
+        raise dataset_error(str(exc), path) from None
     return intrinsics, rigid(translation=t) @ cam0_from_lidar
 
 
@@ -137,18 +134,18 @@ def read_rig_calib(path: str | os.PathLike) -> tuple[Intrinsics, np.ndarray]:
             rows = {str(k): np.asarray(v, np.float64).ravel() for k, v in dict(loaded).items()
                     if k in ("K", "intrinsics", "T_cam_from_lidar")}
         except (OSError, yaml.YAMLError, TypeError, ValueError) as exc:
-            raise dataset_error(f"Cannot read YAML calibration ({type(exc).__name__}: {exc})".replace("\n", " "), path,
-                                FORMATS) from None
+            raise dataset_error(f"Cannot read YAML calibration ({type(exc).__name__}: {exc})".replace("\n", " "),
+                                path) from None
     else:
         rows = read_key_values(path)
     k, t = _need(rows, path, (("K", "intrinsics"), (9, 4)), (("T_cam_from_lidar",), (12, 16)))
     try:
         intrinsics = as_intrinsics(k.reshape(3, 3) if k.size == 9 else k)
     except ValueError as exc:
-        raise dataset_error(str(exc), path, FORMATS) from None
+        raise dataset_error(str(exc), path) from None
     transform = rigid(t)
     if not np.allclose(transform[3], [0, 0, 0, 1]):
-        raise dataset_error("T_cam_from_lidar must end in the row 0 0 0 1 (a rigid transform)", path, FORMATS)
+        raise dataset_error("T_cam_from_lidar must end in the row 0 0 0 1 (a rigid transform)", path)
     return intrinsics, transform
 
 
@@ -162,7 +159,7 @@ def read_calibration(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsi
     if path.is_dir() or path.name in RAW_FILES:
         return read_kitti_raw_calib(path if path.is_dir() else path.parent, camera)
     if not path.is_file():
-        raise dataset_error("Calibration file not found", path, FORMATS)
+        raise dataset_error(f"Calibration file not found (give {FORMATS})", path)
     if path.suffix.lower() in (".yaml", ".yml"):
         return read_rig_calib(path)
     rows = read_key_values(path)
@@ -172,5 +169,5 @@ def read_calibration(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsi
         return read_odometry_calib(path, camera)
     if "T_cam_from_lidar" in rows:
         return read_rig_calib(path)
-    raise dataset_error("Not a calibration file of a known format (no Tr_velo_to_cam, Tr or T_cam_from_lidar)",
-                        path, FORMATS)
+    raise dataset_error(f"Not a calibration file of a known format: no Tr_velo_to_cam, Tr or T_cam_from_lidar; give "
+                        f"{FORMATS}", path)

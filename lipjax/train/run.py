@@ -6,6 +6,7 @@ Used by `python -m experiments.train` and `lipjax train`. Nothing is written out
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 import pathlib
@@ -64,15 +65,19 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
 
 
 def check_writable(folder: str | os.PathLike, what: str) -> None:
-    """Raises OSError (one line) unless a file can be made in `folder` (created if missing): checked before a
-    run, so that a folder the run cannot write fails at once instead of after training."""
-    folder = pathlib.Path(folder)
+    """Raises OSError (one line) unless `folder` could be made and written: its nearest existing ancestor (itself,
+    when it exists) is a folder where a file can be made. Checked before a run, so that a folder the run cannot
+    write fails at once instead of after training; creates nothing."""
+    folder = pathlib.Path(folder).absolute()
+    existing = next(p for p in (folder, *folder.parents) if p.exists())
     try:
-        folder.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=folder):
+        if not existing.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "a file, not a folder")
+        with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as exc:
-        raise OSError(f"cannot write {what} into {folder} ({exc.strerror or exc}); choose a writable folder") from None
+        raise OSError(f"cannot write {what} into {folder} ({existing}: {exc.strerror or exc}); choose a writable "
+                      "folder") from None
 
 
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
