@@ -185,7 +185,7 @@ def _cmd_complete(args) -> int:
             completer = get_completer(args.model, args.iterations, sparse=sparse)
             if args.model is None and not args.quiet:
                 scene, why = scene_reason(sparse)
-                print(f"model: {getattr(completer, 'name', '?')}, the default for {scene} input ({why}); "
+                print(f"model: {completer.name}, the default for {scene} input ({why}); "
                       "choose another with --model", file=sys.stderr)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
             if args.max_side is None and sparse.size > LARGE_FRAME_PIXELS:

@@ -118,8 +118,9 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     Args:
       points_lidar: (N, 3) (or (N, >=3), extra columns such as intensity ignored) points in the LiDAR frame, metres.
       intrinsics: the camera's Intrinsics, (fx, fy, cx, cy) or 3x3 K, pixels.
-      T_cam_from_lidar: (4, 4) rigid transform, p_cam = R p_lidar + t (KITTI: Tr_velo_to_cam; for a rectified
-        KITTI camera use R_rect @ Tr_velo_to_cam, and P_rect's fx fy cx cy). (3, 4) is accepted too.
+      T_cam_from_lidar: (4, 4) rigid transform, p_cam = R p_lidar + t, metres. (3, 4) is accepted too. For a
+        KITTI camera, lipjax.data.calib.read_calibration gives it with the camera's offset from the reference
+        camera: [I | K^-1 P2[:, 3]] @ R0_rect @ Tr_velo_to_cam, not R0_rect @ Tr_velo_to_cam.
       image_size: (H, W) pixels.
       min_depth_m: points with camera z below this (behind the camera or on it) are dropped.
 
