@@ -5,6 +5,8 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
                     [--uncertainty FILE] [--max-uncertainty M]
+    lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
+    lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
@@ -19,7 +21,12 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
   --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
               .png  16-bit, metres = value / S with S = --depth-scale (KITTI 256, NYU 1000, TUM 5000; also the
                     names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
-              .npy  float metres (never scaled).
+              .npy  float metres (never scaled; --depth-scale then only sets the scale of .png output).
+  --lidar   instead of --depth: a LiDAR sweep (KITTI .bin, .npy (N, >=3) x y z metres, or .pcd), projected into
+            the image with --calib (the nearest point per pixel, lipjax.data.lidar): KITTI object calib .txt,
+            a KITTI raw date folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar
+            (lipjax.data.calib); --camera picks KITTI's image (2 = image_2, the default; 3 = image_3). The
+            calibration's intrinsics serve --ply too.
   --out     the extension chooses the format:
               X.npy        float32 metres.
               X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
@@ -94,7 +101,7 @@ def _intrinsics_from_args(args):
     if getattr(args, "intrinsics", None):
         return as_intrinsics(args.intrinsics)
     if getattr(args, "intrinsics_file", None):
-        return read_intrinsics_txt(args.intrinsics_file)
+        return read_intrinsics_txt(args.intrinsics_file, getattr(args, "camera", 2))
     return None
 
 
@@ -112,16 +119,25 @@ def _model_max_depth(completer) -> float:
 
 def _cmd_complete(args) -> int:
     from lipjax.data.folder import check_one_depth_format, output_format, pair_frames, read_frame, write_depth
+    from lipjax.data.lidar import read_lidar_frame
     from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, frame_size, get_completer
+    from lipjax.inputs import scene_reason
     from lipjax.pointcloud import backproject_rgbd, write_ply
     from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
 
-    rgb_path, depth_path, out, ply = Path(args.rgb), Path(args.depth), Path(args.out), args.ply and Path(args.ply)
+    if (args.depth is None) == (args.lidar is None):
+        raise CLIError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
+    if (args.lidar is None) != (args.calib is None):
+        raise CLIError("--lidar SWEEP and --calib FILE go together: the sweep, and its calibration with the camera")
+    rgb_path, out, ply = Path(args.rgb), Path(args.out), args.ply and Path(args.ply)
+    depth_path = Path(args.depth or args.lidar)
+    if args.lidar and rgb_path.is_dir():
+        raise CLIError("--lidar takes one sweep with one --rgb image, not a folder")
     unc = args.uncertainty and Path(args.uncertainty)
     if args.max_uncertainty is not None and not args.max_uncertainty >= 0:
         raise CLIError(f"--max-uncertainty {args.max_uncertainty:g}: must be >= 0 metres")
     intrinsics = _intrinsics_from_args(args)
-    if ply and intrinsics is None:
+    if ply and intrinsics is None and not args.lidar:
         raise CLIError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
     if args.color_range and not args.color_range[1] > args.color_range[0]:
         raise CLIError(f"--color-range {args.color_range[0]:g} {args.color_range[1]:g}: MAX_M must be > MIN_M")
@@ -137,15 +153,20 @@ def _cmd_complete(args) -> int:
             if path and path.exists() and not path.is_dir():
                 raise CLIError(f"{flag} {path}: with input folders, {flag} must be a folder")
         fmt = args.out_format or ("png" if pairs[0][1].suffix.lower() == ".png" else "npy")
+        npy_in = pairs[0][1].suffix.lower() == ".npy"
         jobs = [(r, d, out / f"{r.stem}.{fmt}", ply / f"{r.stem}.ply" if ply else None) for r, d in pairs]
     else:
         if args.out_format:
             raise CLIError("--out-format is for folders; for one frame the extension of --out chooses the format")
         fmt = output_format(out)
+        npy_in = depth_path.suffix.lower() != ".png"
         jobs = [(rgb_path, depth_path, out, ply or None)]
         if unc and unc.suffix.lower() not in (".npy", ".png"):
             raise CLIError(f"--uncertainty {unc}: use .npy (metres) or .png (colour picture)")
     out_scale = args.depth_scale or DEFAULT_PNG_OUT_SCALE
+    if args.depth_scale and npy_in and fmt != "png":
+        _warn(f"--depth-scale {args.depth_scale:g} is ignored: {'the sweep is' if args.lidar else '.npy depth is'} "
+              "metres, never scaled (--depth-scale applies to .png depth, in and out)")
 
     completer = None  # loaded after the first frame is read: input errors come before the slow model load
     progress = jobs
@@ -154,9 +175,17 @@ def _cmd_complete(args) -> int:
 
         progress = tqdm(jobs, desc=f"{PROG} complete", unit="frame", file=sys.stderr)
     for rgb_file, depth_file, out_file, ply_file in progress:
-        rgb, sparse = read_frame(rgb_file, depth_file, args.depth_scale)
+        if args.lidar:
+            rgb, sparse, calib_intrinsics = read_lidar_frame(rgb_file, depth_file, args.calib, args.camera)
+            intrinsics = intrinsics or calib_intrinsics
+        else:
+            rgb, sparse = read_frame(rgb_file, depth_file, args.depth_scale)
         if completer is None:
             completer = get_completer(args.model, args.iterations, sparse=sparse)
+            if args.model is None and not args.quiet:
+                scene, why = scene_reason(sparse)
+                print(f"model: {completer.name}, the default for {scene} input ({why}); "
+                      "choose another with --model", file=sys.stderr)
             color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
             h, w = frame_size(completer, sparse, args.max_side)
             if args.max_side is None and h * w > LARGE_FRAME_PIXELS:
@@ -353,7 +382,46 @@ def _cmd_train(args) -> int:
     return 0
 
 
+def _cmd_project(args) -> int:
+    from lipjax.data.folder import output_format, write_depth
+    from lipjax.data.lidar import read_lidar_frame
+
+    fmt = output_format(args.out)
+    _, sparse, _ = read_lidar_frame(args.rgb, args.lidar, args.calib, args.camera)
+    write_depth(args.out, sparse, fmt, args.depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
+    if not args.quiet:
+        n, (h, w) = int((sparse > 0).sum()), sparse.shape
+        print(f"wrote {args.out}: depth at {n} pixels ({100 * n / sparse.size:.1f} % of {w}x{h}), "
+              f"{sparse[sparse > 0].min():.2f} to {sparse.max():.2f} m", file=sys.stderr)
+    return 0
+
+
 # ------------------------------------------------------------------------------------------------- parsing
+
+
+def _add_lidar_args(parser, required: bool) -> None:
+    """--lidar, --calib, --camera: of `project`, and of `complete` as the alternative to --depth."""
+    parser.add_argument("--lidar", required=required, default=None, metavar="SWEEP",
+                        help="LiDAR sweep: KITTI .bin, .npy (N, >=3) x y z metres, or .pcd")
+    parser.add_argument("--calib", required=required, default=None, metavar="FILE",
+                        help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig "
+                             ".txt/.yaml with K and T_cam_from_lidar (lipjax.data.calib)")
+    parser.add_argument("--camera", type=int, default=2, metavar="N",
+                        help="the KITTI camera of --rgb: 2 (image_2, default) or 3")
+
+
+def _add_project_parser(sub) -> None:
+    p = sub.add_parser("project", help="project a LiDAR sweep into a camera image: the sparse depth input",
+                       description="Projects a LiDAR sweep into the camera of --rgb (the nearest point per pixel; "
+                                   "depth = z in the camera frame, metres) and writes the sparse depth image.")
+    _add_lidar_args(p, required=True)
+    p.add_argument("--rgb", required=True, help="the camera's image (gives the size)")
+    p.add_argument("--out", required=True,
+                   help="SPARSE.npy (float32 metres) | .png (16-bit, value = metres * --depth-scale) | .color.png")
+    p.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
+                   help=f"PNG value per metre of .png output (default {DEFAULT_PNG_OUT_SCALE:g}, KITTI's)")
+    p.add_argument("-q", "--quiet", action="store_true", help="no summary line")
+    p.set_defaults(func=_cmd_project)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -370,8 +438,9 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
                        formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
-    c.add_argument("--depth", required=True,
+    c.add_argument("--depth", default=None,
                    help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
+    _add_lidar_args(c, required=False)
     c.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output "
                         "(default 256)")
@@ -389,13 +458,15 @@ def build_parser() -> argparse.ArgumentParser:
     intr = c.add_mutually_exclusive_group()
     intr.add_argument("--intrinsics", type=float, nargs=4, metavar=("FX", "FY", "CX", "CY"),
                       help="pixels, of the RGB image")
-    intr.add_argument("--intrinsics-file", default=None, metavar="F", help='"fx fy cx cy" or the 9 numbers of K')
+    intr.add_argument("--intrinsics-file", default=None, metavar="F",
+                      help='"fx fy cx cy", the 9 numbers of K, or a calibration file (as --calib)')
     c.add_argument("--uncertainty", default=None, metavar="FILE",
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, default=None, metavar="M",
                    help="depth 0 (none) where the expected error is above M metres, in --out and --ply")
-    c.add_argument("--quiet", action="store_true", help="no progress bar or summary")
+    c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
     c.set_defaults(func=_cmd_complete)
+    _add_project_parser(sub)
 
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
                        "data source (Markdown table)")

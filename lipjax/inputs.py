@@ -5,6 +5,7 @@ and one set of messages, each naming the problem.
     rgb, sparse = check_frame(rgb, sparse)              # exactly one (H, W, 3) uint8 frame (classical methods)
     check_for_model(sparse, max_depth_m=10.0, name="lip-ad-indoor")   # units, range and pattern vs the model
     scene = suggest_scene(sparse)                       # "indoor" | "outdoor": which default model fits the input
+    scene, why = scene_reason(sparse)                   # and the evidence, in words
 
 Sparse depth is float metres with 0 = no sample. A unit mistake that is near certain raises InputError; one that is
 only probable, or data unlike what the model was trained on, gives a one-line `warnings.warn` naming the likely
@@ -121,13 +122,21 @@ def is_lidar_pattern(sparse: np.ndarray) -> bool:
 def suggest_scene(sparse: np.ndarray) -> str:
     """"outdoor" when the (H, W) or (B, H, W) samples (metres) look outdoor (median over OUTDOOR_MEDIAN_M, or
     LiDAR scan lines), else "indoor": which default model to use."""
+    return scene_reason(sparse)[0]
+
+
+def scene_reason(sparse: np.ndarray) -> tuple[str, str]:
+    """(suggest_scene's answer, why, a few words naming the evidence: "median sample depth 23.1 m", ...)."""
     sparse = np.asarray(sparse, np.float32)
     samples = sparse[sparse > 0]
     if sparse.ndim not in (2, 3) or samples.size == 0:
-        return "indoor"  # nothing to judge: the input checks will name the problem
-    if float(np.median(samples)) > OUTDOOR_MEDIAN_M:
-        return "outdoor"
-    return "outdoor" if any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:])) else "indoor"
+        return "indoor", "no samples to judge"  # the input checks will name the problem
+    median = float(np.median(samples))
+    if median > OUTDOOR_MEDIAN_M:
+        return "outdoor", f"median sample depth {median:.1f} m, over {OUTDOOR_MEDIAN_M:g} m"
+    if any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:])):
+        return "outdoor", f"samples in LiDAR scan lines, median depth {median:.1f} m"
+    return "indoor", f"scattered samples, median depth {median:.1f} m"
 
 
 def _other_model(name: str, scene: str) -> str:

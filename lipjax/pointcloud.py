@@ -8,6 +8,7 @@ axis (not the range along the ray), as in KITTI, NYU and TUM depth images.
     points = backproject(depth_m, intrinsics)                         # (N, 3) for the valid pixels
     write_ply("cloud.ply", *backproject_rgbd(depth_m, rgb, intrinsics))
     sparse = project_lidar_to_depth(scan_xyz, intrinsics, T_cam_from_lidar, (H, W))   # the model's input
+    scan_xyz = read_point_cloud("000000.bin")                         # KITTI .bin, .npy or .pcd, metres
 """
 from __future__ import annotations
 
@@ -117,8 +118,9 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     Args:
       points_lidar: (N, 3) (or (N, >=3), extra columns such as intensity ignored) points in the LiDAR frame, metres.
       intrinsics: the camera's Intrinsics, (fx, fy, cx, cy) or 3x3 K, pixels.
-      T_cam_from_lidar: (4, 4) rigid transform, p_cam = R p_lidar + t (KITTI: Tr_velo_to_cam; for a rectified
-        KITTI camera use R_rect @ Tr_velo_to_cam, and P_rect's fx fy cx cy). (3, 4) is accepted too.
+      T_cam_from_lidar: (4, 4) rigid transform, p_cam = R p_lidar + t, metres. (3, 4) is accepted too. For a
+        KITTI camera, lipjax.data.calib.read_calibration gives it with the camera's offset from the reference
+        camera: [I | K^-1 P2[:, 3]] @ R0_rect @ Tr_velo_to_cam, not R0_rect @ Tr_velo_to_cam.
       image_size: (H, W) pixels.
       min_depth_m: points with camera z below this (behind the camera or on it) are dropped.
 
@@ -148,3 +150,79 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     pixel = row[inside].astype(np.int64) * w + col[inside].astype(np.int64)
     z = z[inside]
     return splat_nearest(pixel, z, (h, w))
+
+
+POINT_CLOUD_FORMATS = ".bin (KITTI: float32 x y z reflectance), .npy ((N, >=3) x y z ...) or .pcd (ascii / binary)"
+_PCD_TYPES = {("F", 4): "<f4", ("F", 8): "<f8", ("I", 1): "i1", ("I", 2): "<i2", ("I", 4): "<i4", ("I", 8): "<i8",
+              ("U", 1): "u1", ("U", 2): "<u2", ("U", 4): "<u4", ("U", 8): "<u8"}
+
+
+def read_point_cloud(path: str | os.PathLike) -> np.ndarray:
+    """(N, 3) float32 x, y, z (metres, in the sensor's frame) of a point cloud file: a KITTI .bin (float32 x, y,
+    z, reflectance per point), a .npy (N, >=3) array whose first three columns are x, y, z, or a PCD file
+    (DATA ascii or binary, fields x y z). Other columns are dropped; non-finite points are kept (the projection
+    drops them). Raises ValueError naming the file and the problem."""
+    path = pathlib.Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".bin":
+        raw = np.fromfile(path, dtype=np.float32)
+        if raw.size % 4:
+            raise ValueError(f"{path}: a KITTI .bin sweep holds 4 float32 per point (x y z reflectance); its size "
+                             f"({raw.size * 4} bytes) is not a multiple of 16: corrupt, or another format")
+        return raw.reshape(-1, 4)[:, :3]
+    if suffix == ".npy":
+        try:
+            points = np.load(path, allow_pickle=False)
+        except (OSError, ValueError) as exc:
+            raise ValueError(f"{path}: cannot read the .npy point cloud ({exc})") from None
+        if points.ndim != 2 or points.shape[1] < 3 or not np.issubdtype(points.dtype, np.number):
+            raise ValueError(f"{path}: a .npy point cloud must be a numeric (N, 3) or (N, >=3) array of x y z "
+                             f"metres, got {points.dtype} {points.shape}")
+        return np.ascontiguousarray(points[:, :3], dtype=np.float32)
+    if suffix == ".pcd":
+        return _read_pcd(path)
+    raise ValueError(f"{path}: unknown point cloud format {suffix!r}; use {POINT_CLOUD_FORMATS}")
+
+
+def _read_pcd(path: pathlib.Path) -> np.ndarray:
+    """x, y, z of a PCD file (https://pointclouds.org/documentation/tutorials/pcd_file_format.html)."""
+    blob = path.read_bytes()
+    header, offset = {}, 0
+    while "DATA" not in header:
+        end = blob.find(b"\n", offset)
+        if end < 0:
+            raise ValueError(f"{path}: not a PCD file (no DATA line in its header)")
+        line = blob[offset:end].decode("ascii", "replace").strip()
+        offset = end + 1
+        if line and not line.startswith("#"):
+            key, _, value = line.partition(" ")
+            header[key.upper()] = value.split()
+    try:
+        fields = header["FIELDS"]
+        sizes = [int(v) for v in header["SIZE"]]
+        types = header["TYPE"]
+        counts = [int(v) for v in header.get("COUNT", ["1"] * len(fields))]
+        points = int(header["POINTS"][0]) if "POINTS" in header else int(header["WIDTH"][0]) * int(
+            header["HEIGHT"][0])
+        dtype = np.dtype([(f"{name}_{i}", _PCD_TYPES[(t.upper(), s)], (c,))
+                          for i, (name, s, t, c) in enumerate(zip(fields, sizes, types, counts))])
+    except (KeyError, ValueError, IndexError) as exc:
+        raise ValueError(f"{path}: PCD header lacks or garbles {exc} (needs FIELDS, SIZE, TYPE, POINTS)") from None
+    if not {"x", "y", "z"} <= set(fields):
+        raise ValueError(f"{path}: PCD fields {fields} lack x, y, z")
+    mode = header["DATA"][0].lower()
+    if mode == "binary":
+        if len(blob) - offset < points * dtype.itemsize:
+            raise ValueError(f"{path}: PCD file truncated ({points} points announced)")
+        data = np.frombuffer(blob, dtype, count=points, offset=offset)
+        columns = {name: data[f"{name}_{i}"][:, 0] for i, name in enumerate(fields)}
+    elif mode == "ascii":
+        table = np.loadtxt(blob[offset:].decode("ascii").splitlines(), dtype=np.float64, ndmin=2)
+        starts = np.cumsum([0] + counts)
+        if table.shape != (points, starts[-1]):
+            raise ValueError(f"{path}: PCD announces {points} points of {starts[-1]} values, found {table.shape}")
+        columns = {name: table[:, starts[i]] for i, name in enumerate(fields)}
+    else:
+        raise ValueError(f"{path}: PCD DATA {mode}: not supported; save it as ascii or binary "
+                         "(pcl_convert_pcd_ascii_binary IN OUT 1)")
+    return np.stack([columns["x"], columns["y"], columns["z"]], axis=1).astype(np.float32)

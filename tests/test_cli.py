@@ -138,6 +138,8 @@ def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, t
                              "the file holds ['encoder'])"),
     ("model_json_bad_field", "bad.json: not a valid lipjax model config (TypeError: "),
     ("model_file_truncated", "bad.msgpack: cannot read the parameters, the file is damaged or truncated"),
+    ("depth_as_rgb", "A 16-bit single-channel PNG is a depth map, not a colour image"),
+    ("no_depth", "give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE"),
 ])
 def test_user_errors_are_one_line_without_traceback(case, message, model, frame, tmp_path, capsys):
     rgb, depth, model_arg, extra = frame["rgb"], frame["npy"], model[0], []
@@ -162,7 +164,10 @@ def test_user_errors_are_one_line_without_traceback(case, message, model, frame,
         extra = ["--ply", str(tmp_path / "x.ply"), "--intrinsics", "0", "0", "0", "0"]
     elif case.startswith("model_"):
         model_arg = _broken_model(case, model, tmp_path / "bad")
-    rc = cli.main(["complete", "--rgb", str(rgb), "--depth", str(depth), "--model", model_arg,
+    elif case == "depth_as_rgb":
+        rgb = frame["png"]
+    depth_args = [] if case == "no_depth" else ["--depth", str(depth)]
+    rc = cli.main(["complete", "--rgb", str(rgb), *depth_args, "--model", model_arg,
                    "--out", str(tmp_path / "out.npy"), *extra])
     err = capsys.readouterr().err
     assert rc == 1
@@ -186,6 +191,53 @@ def _broken_model(case, model, stem):
     stem.with_name("bad.json").write_text(json.dumps(doc))
     stem.with_name("bad.msgpack").write_bytes(params)
     return str(stem)
+
+
+def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_ply(model, tmp_path):
+    """`complete --lidar SWEEP --calib FILE`: the output is the model's completion of project_sweep's sparse map,
+    and --ply needs no --intrinsics: the calibration's give the cloud that --intrinsics FX FY CX CY and
+    --intrinsics-file CALIB give from the same sparse map as --depth."""
+    from lipjax.data.lidar import project_sweep
+    from test_calib import CX, CY, FX, FY, _cam_from_velo, write_object_calib
+
+    rgb, _ = _frame(seed=3, h=40, w=120)
+    cv2.imwrite(str(tmp_path / "image.png"), rgb[..., ::-1])
+    rng = np.random.default_rng(2)
+    cam2 = np.stack([rng.uniform(-0.3, 0.3, 400), rng.uniform(-0.1, 0.1, 400), rng.uniform(2, 5, 400), np.ones(400)])
+    np.save(tmp_path / "sweep.npy", (np.linalg.inv(_cam_from_velo(2)) @ cam2)[:3].T)
+    calib = write_object_calib(tmp_path / "calib.txt")
+    rc = cli.main(["complete", "--rgb", str(tmp_path / "image.png"), "--lidar", str(tmp_path / "sweep.npy"),
+                   "--calib", str(calib), "--model", model[0], "--out", str(tmp_path / "out.npy"),
+                   "--ply", str(tmp_path / "a.ply"), "-q"])
+    assert rc == 0
+    sparse, _ = project_sweep(tmp_path / "sweep.npy", calib, (40, 120))
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), model[1](rgb, sparse), rtol=1e-6)
+    np.save(tmp_path / "sparse.npy", sparse)
+    for ply, intrinsics in (("b.ply", ["--intrinsics", str(FX), str(FY), str(CX), str(CY)]),
+                            ("c.ply", ["--intrinsics-file", str(calib)])):
+        assert cli.main(["complete", "--rgb", str(tmp_path / "image.png"), "--depth", str(tmp_path / "sparse.npy"),
+                         "--model", model[0], "--out", str(tmp_path / "o.npy"), "--ply", str(tmp_path / ply),
+                         *intrinsics, "-q"]) == 0
+        assert (tmp_path / "a.ply").read_bytes() == (tmp_path / ply).read_bytes(), ply
+
+
+def test_the_default_model_is_named_with_its_reason_and_depth_scale_on_npy_warns(model, frame, tmp_path, capsys,
+                                                                                monkeypatch):
+    """Without --model, one line names the model chosen and why (none with -q); --depth-scale with .npy depth and
+    .npy output warns that it is ignored."""
+    monkeypatch.setattr(lipjax.inference, "default_model", lambda scene: model[1])
+    args = ["complete", "--rgb", frame["rgb"], "--depth", frame["npy"], "--out", str(tmp_path / "out.npy")]
+    assert cli.main(args) == 0
+    median = np.median(frame["sparse_array"][frame["sparse_array"] > 0])
+    assert capsys.readouterr().err.splitlines()[0] == (
+        f"model: {model[0]}, the default for indoor input (scattered samples, median depth {median:.1f} m); "
+        "choose another with --model")
+    assert cli.main(args + ["-q"]) == 0 and capsys.readouterr().err == ""
+    assert cli.main(args + ["-q", "--depth-scale", "256"]) == 0
+    assert capsys.readouterr().err == ("lipjax: warning: --depth-scale 256 is ignored: .npy depth is metres, never "
+                                       "scaled (--depth-scale applies to .png depth, in and out)\n")
+    assert cli.main(args[:-1] + [str(tmp_path / "out.png"), "-q", "--depth-scale", "256"]) == 0  # the PNG's scale
+    assert capsys.readouterr().err == ""
 
 
 def test_usage_error_returns_2_with_one_line(capsys):

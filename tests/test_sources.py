@@ -346,6 +346,34 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
     assert np.load(tmp_path / "out.npy").shape == (H, W)
 
 
+def test_lipjax_train_checks_its_output_folder_and_every_frame_before_training(tmp_path, capsys):
+    """`lipjax train` fails before training, with one line and no workdir: when --out's folder cannot be written,
+    and when frames are unreadable (naming every one: a corrupt RGB, a truncated depth PNG, and the sparse map
+    of a run that trains on the folder's own input)."""
+    from lipjax import cli
+    from lipjax.train.folder import check_frames
+
+    root = make_folder(tmp_path / "folder")
+    (tmp_path / "blocker").write_text("a file where the model's folder should be")
+    args = ["train", "--data", str(root), "--depth-scale", "1000", "--steps", "2", "--workers", "0", "--quiet",
+            "--workdir", str(tmp_path / "run")]
+    assert cli.main(args + ["--out", str(tmp_path / "blocker" / "model")]) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines == [f"lipjax: error: cannot write the model (--out / --export) into {tmp_path / 'blocker'} "
+                     f"({tmp_path / 'blocker'}: a file, not a folder); choose a writable folder"]
+    assert check_frames(dataclasses.replace(CONFIG.data, source="folder", root=str(root), depth_scale=1000)) == 6
+    (root / "rgb" / "0001.png").write_bytes(b"not a png")
+    (root / "depth" / "0004.png").write_bytes((root / "depth" / "0004.png").read_bytes()[:60])
+    (root / "sparse" / "0002.png").write_bytes(b"")
+    assert cli.main(args + ["--out", str(tmp_path / "model" / "mine"), "--sampler", "input"]) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines == [f"lipjax: error: 3 unreadable file(s) in {root}, checked before training: Cannot read RGB image "
+                     "(missing, corrupt or unsupported format): rgb/0001.png; Cannot read depth PNG (missing, "
+                     "corrupt or not an image): depth/0004.png; Cannot read depth PNG (missing, corrupt or not an "
+                     "image): sparse/0002.png; fix or remove them (with their partner files)"]
+    assert not (tmp_path / "run").exists() and not (tmp_path / "model").exists()
+
+
 def test_lipjax_data_render_command(tmp_path, capsys):
     from lipjax import cli
 

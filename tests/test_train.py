@@ -288,6 +288,64 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
     assert int(state.step) == meta["data_position"] == saved[0] and meta["data_loader"]["next_step"] == saved[0]
 
 
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_ctrl_c_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
+    """Ctrl-C as a terminal sends it (SIGINT to the whole process group, loader workers included) saves the step
+    in progress, although no checkpoint was due, says so, exits with 130, and the workers end with the run."""
+    workdir = tmp_path / "run"
+    cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
+           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=100000",
+           "--set", "log_every=1", "--set", "eval_every=0"]
+    with open(tmp_path / "out.txt", "w") as out:
+        proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT,
+                                start_new_session=True)  # its own process group, as a terminal's foreground job
+    metrics = workdir / "metrics.jsonl"
+    try:
+        deadline = time.time() + 240
+        while not (metrics.exists() and metrics.read_text().count("\n") >= 2) and time.time() < deadline:
+            time.sleep(0.2)
+        workers = _children(proc.pid)
+        assert workers, "the run should have a loader worker process"
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.wait(timeout=60) == 130
+    finally:
+        proc.kill()
+    logged = [json.loads(line)["step"] for line in metrics.read_text().splitlines()]
+    saved = [int(p.name) for p in (workdir / "checkpoints").glob("[0-9]*")]
+    assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
+    text = (tmp_path / "out.txt").read_text()
+    said = f"[lipjax] SIGINT: saved step {saved[0]} in {workdir / 'checkpoints'}; stopping (run again to resume)"
+    assert said in text
+    assert "Traceback" not in text, text[-3000:]
+    deadline = time.time() + 20
+    while [w for w in workers if _alive(w)] and time.time() < deadline:
+        time.sleep(0.2)
+    assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
+
+
+def test_a_second_signal_exits_at_once_and_the_handlers_are_restored():
+    """The first SIGINT or SIGTERM only asks the loop to save and stop; a second exits at once (KeyboardInterrupt
+    for Ctrl-C, SystemExit(143) for SIGTERM); afterwards the previous handlers are back. A multi-process run
+    (save_first=False) exits on the first SIGTERM and leaves SIGINT to Python."""
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    for signum, second in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, SystemExit)):
+        with loop._signals_as_exit(save_first=True) as stop:
+            os.kill(os.getpid(), signum)
+            time.sleep(0.01)  # the handler runs between bytecodes
+            assert stop.is_set() and stop.signum == signum
+            with pytest.raises(second) as info:
+                os.kill(os.getpid(), signum)
+                time.sleep(1)
+            assert signum == signal.SIGINT or info.value.code == 143
+        assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+    with loop._signals_as_exit(save_first=False) as stop:
+        assert signal.getsignal(signal.SIGINT) == before[0]
+        with pytest.raises(SystemExit):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1)
+        assert not stop.is_set()
+
+
 def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_path, capsys):
     """An indoor model fine-tuned outdoors: another depth range and initial fill, the same parameter tree, are
     accepted (the saved parameters, unchanged); another architecture is a one-line error."""

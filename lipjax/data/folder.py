@@ -5,7 +5,8 @@ Folder layout (frames matched by file stem):
     <root>/rgb/<stem>.png|.jpg|.jpeg          colour image (any bit depth; read as 8-bit RGB)
     <root>/depth/<stem>.png                   16-bit depth, metres = value / depth_scale, 0 = invalid
     <root>/depth/<stem>.npy                   float depth in metres (0 = invalid)
-    <root>/intrinsics.txt                     optional: "fx fy cx cy" or the 9 numbers of K (row-major)
+    <root>/intrinsics.txt                     optional: "fx fy cx cy", the 9 numbers of K (row-major), the 12 of
+                                          a 3x4 P, or a calibration file (lipjax.data.calib: KITTI, any rig)
     <root>/intrinsics/<stem>.txt              optional, per frame, same format
 
 Depth scales of common sensors (raw PNG value per metre): KITTI 256, NYU / Kinect / RealSense 1000,
@@ -47,8 +48,24 @@ def natural_key(text: str) -> tuple:
     return tuple(int(tok) if tok.isdigit() else tok for tok in _DIGITS.split(text))
 
 
+def _is_depth_png(path: str | os.PathLike) -> bool:
+    """Whether a file is a 16-bit single-channel PNG (a depth map), from its header alone (PNG IHDR: bit depth at
+    byte 24, colour type 0 = grey at byte 25)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(26)
+    except OSError:
+        return False
+    is_png = head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR"
+    return is_png and head[24:26] == b"\x10\x00"
+
+
 def read_rgb(path: str | os.PathLike) -> np.ndarray:
-    """Reads a colour image as (H, W, 3) uint8 RGB (cv2 decodes BGR; converted here). Grey images get 3 channels."""
+    """Reads a colour image as (H, W, 3) uint8 RGB (cv2 decodes BGR; converted here). Grey images get 3 channels;
+    a 16-bit grey PNG is a depth map given in place of the colour image, and raises DatasetError."""
+    if _is_depth_png(path):
+        raise dataset_error("A 16-bit single-channel PNG is a depth map, not a colour image: give it as the depth "
+                            "and the camera's colour image as the RGB", path)
     image = cv2.imread(os.fspath(path), cv2.IMREAD_COLOR)
     if image is None:
         raise dataset_error("Cannot read RGB image (missing, corrupt or unsupported format)", path)
@@ -103,15 +120,28 @@ def read_depth(path: str | os.PathLike, scale: float | None = None) -> np.ndarra
     return depth
 
 
-def read_intrinsics_txt(path: str | os.PathLike) -> Intrinsics:
-    """Reads "fx fy cx cy" (4 numbers) or a row-major 3x3 K (9 numbers), any whitespace, in pixels."""
+def read_intrinsics_txt(path: str | os.PathLike, camera: int = 2) -> Intrinsics:
+    """Reads "fx fy cx cy" (4 numbers), a row-major 3x3 K (9 numbers) or a rectified camera's 3x4 P = K [I | t]
+    (12 numbers), any whitespace, in pixels; or the intrinsics of KITTI camera `camera` (a rig's one camera) in a
+    calibration file of any lipjax.data.calib format."""
     try:
-        values = [float(tok) for tok in Path(path).read_text().split()]
-    except (OSError, ValueError) as exc:
+        tokens = Path(path).read_text().split()
+    except (OSError, UnicodeDecodeError) as exc:
         raise dataset_error(f"Cannot read intrinsics ({exc})", path) from exc
-    if len(values) not in (4, 9):
-        raise dataset_error(f"Intrinsics file must hold 4 numbers (fx fy cx cy) or 9 (K), found {len(values)}", path)
     try:
+        values = [float(tok) for tok in tokens]
+    except ValueError:
+        from lipjax.data.calib import read_calibration
+
+        return read_calibration(path, camera)[0]
+    if len(values) not in (4, 9, 12):
+        raise dataset_error(f"Intrinsics file must hold 4 numbers (fx fy cx cy), 9 (K) or 12 (a 3x4 P), or be a "
+                            f"calibration file (P2: ..., lipjax.data.calib); found {len(values)} numbers", path)
+    try:
+        if len(values) == 12:
+            from lipjax.data.calib import camera_from_projection
+
+            return camera_from_projection(np.asarray(values))[0]
         return as_intrinsics(np.asarray(values).reshape(3, 3) if len(values) == 9 else values)
     except ValueError as exc:
         raise dataset_error(str(exc), path) from exc

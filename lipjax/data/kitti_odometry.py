@@ -17,10 +17,11 @@ from pathlib import Path
 
 import numpy as np
 
+from lipjax.data.calib import camera_from_projection, read_key_values, rigid
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import natural_key, read_rgb
 from lipjax.data.sample import Intrinsics, Sample
-from lipjax.pointcloud import project_lidar_to_depth
+from lipjax.pointcloud import project_lidar_to_depth, read_point_cloud
 
 KITTI_ODOMETRY_LAYOUT = """\
 <root>/sequences/<SS>/image_2/<NNNNNN>.png
@@ -29,34 +30,27 @@ KITTI_ODOMETRY_LAYOUT = """\
 KITTI_ODOMETRY_SOURCE = "KITTI odometry benchmark (colour images, Velodyne laser data, calibration files)"
 
 
-def read_odometry_calib(path: str | os.PathLike) -> tuple[Intrinsics, np.ndarray]:
-    """(intrinsics of image_2, (4, 4) T_cam2_from_velodyne) from a sequence's calib.txt."""
+def read_odometry_calib(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
+    """(intrinsics of image_<camera>, (4, 4) T_cam_from_velodyne, metres) from a sequence's calib.txt: P_X and Tr
+    (velodyne -> cam0), T = [I | K^-1 P_X[:, 3]] @ Tr (lipjax.data.calib)."""
+    rows = read_key_values(path, KITTI_ODOMETRY_LAYOUT, KITTI_ODOMETRY_SOURCE)
     try:
-        rows = {}
-        for line in Path(path).read_text().splitlines():
-            key, sep, values = line.partition(":")
-            if sep:
-                rows[key.strip()] = np.array([float(v) for v in values.split()])
-        p2, tr = rows["P2"].reshape(3, 4), rows["Tr"].reshape(3, 4)
-    except (OSError, KeyError, ValueError) as e:
+        p, tr = rows[f"P{camera}"].reshape(3, 4), rows["Tr"].reshape(3, 4)
+        intrinsics, t = camera_from_projection(p)
+    except (KeyError, ValueError) as e:
         raise dataset_error(f"Cannot read KITTI odometry calibration ({e})", path, KITTI_ODOMETRY_LAYOUT,
                             KITTI_ODOMETRY_SOURCE) from None
-    fx, fy, cx, cy = p2[0, 0], p2[1, 1], p2[0, 2], p2[1, 2]
-    # P2 = K [I | t]: image_2's offset from the rectified cam0 (a baseline along x, in metres).
-    t = np.array([(p2[0, 3] - cx * p2[2, 3]) / fx, (p2[1, 3] - cy * p2[2, 3]) / fy, p2[2, 3]])
-    cam2_from_velo = np.eye(4)
-    cam2_from_velo[:3] = tr
-    cam2_from_velo[:3, 3] += t
-    return Intrinsics(fx, fy, cx, cy), cam2_from_velo
+    # P_X = K [I | t]: image_X's offset from the rectified cam0 (a baseline along x, in metres).
+    return intrinsics, rigid(translation=t) @ rigid(tr)
 
 
 def read_velodyne_bin(path: str | os.PathLike) -> np.ndarray:
     """(N, 3) float32 points in metres from a KITTI .bin scan (float32 x, y, z, reflectance per point)."""
-    raw = np.fromfile(os.fspath(path), dtype=np.float32)
-    if raw.size % 4:
-        raise dataset_error("Corrupt Velodyne scan (size not a multiple of 4 float32)", path, KITTI_ODOMETRY_LAYOUT,
-                            KITTI_ODOMETRY_SOURCE)
-    return raw.reshape(-1, 4)[:, :3]
+    try:
+        return read_point_cloud(path)
+    except ValueError as exc:
+        raise dataset_error(f"Corrupt Velodyne scan ({exc})", path, KITTI_ODOMETRY_LAYOUT,
+                            KITTI_ODOMETRY_SOURCE) from None
 
 
 class KittiOdometry:

@@ -195,10 +195,15 @@ def _grain():
 
 
 def _single_threaded_worker(worker_index: int, worker_count: int) -> None:
-    """Each worker process uses one core: OpenCV's own thread pool would make the workers compete for cores."""
+    """Each worker process uses one core: OpenCV's own thread pool would make the workers compete for cores.
+    Workers ignore SIGINT: a terminal's Ctrl-C reaches the whole process group, and the training loop, not each
+    worker, decides what it means (lipjax.train.loop: save the step in progress, then stop the workers)."""
+    import signal
+
     import cv2
 
     cv2.setNumThreads(1)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 class TrainLoader:

@@ -86,32 +86,44 @@ def _initial_g_params(config: TrainConfig):
     return params
 
 
-@contextlib.contextmanager
-def _sigterm_as_exit(save_first: bool):
-    """SIGTERM ends a training run with SystemExit(143) so that the `finally` blocks run: the loader's worker
-    processes stop with the run instead of outliving it; started again, the run resumes.
+class _Stop(threading.Event):
+    """Set by the first SIGTERM or SIGINT (Ctrl-C) of a run; `signum` says which."""
 
-    Yields a threading.Event. save_first (a single-process run): the first SIGTERM only sets it; the loop then
-    finishes the step it is in, saves a checkpoint of it and exits, so a preempted run loses no step. A second
-    SIGTERM exits at once (the last saved checkpoint is kept). A multi-process run exits at once: a checkpoint
-    is a collective write that every process would have to reach at the same step. No-op outside the main
-    thread."""
-    stop = threading.Event()
+    signum: int = signal.SIGTERM
+
+
+@contextlib.contextmanager
+def _signals_as_exit(save_first: bool):
+    """SIGTERM and SIGINT (Ctrl-C) end a training run with SystemExit(128 + signal: 143, 130) so that the
+    `finally` blocks run: the loader's worker processes stop with the run instead of outliving it; started
+    again, the run resumes.
+
+    Yields a _Stop event. save_first (a single-process run): the first signal only sets it; the loop then
+    finishes the step it is in, saves a checkpoint of it and exits, so a preempted or interrupted run loses no
+    step. A second signal exits at once (SIGINT as KeyboardInterrupt; the last saved checkpoint is kept). A
+    multi-process run exits at once on SIGTERM, and SIGINT keeps Python's KeyboardInterrupt: a checkpoint is a
+    collective write that every process would have to reach at the same step. No-op outside the main thread."""
+    stop = _Stop()
     if threading.current_thread() is not threading.main_thread():
         yield stop
         return
 
-    def on_sigterm(signum, frame):
+    def on_signal(signum, frame):
         if save_first and not stop.is_set():
+            stop.signum = signum
             stop.set()
             return
+        if signum == signal.SIGINT:
+            raise KeyboardInterrupt
         raise SystemExit(128 + signum)
 
-    previous = signal.signal(signal.SIGTERM, on_sigterm)
+    previous = {s: signal.signal(s, on_signal) for s in ((signal.SIGTERM, signal.SIGINT) if save_first
+                                                          else (signal.SIGTERM,))}
     try:
         yield stop
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for s, handler in previous.items():
+            signal.signal(s, handler)
 
 
 def train(
@@ -171,7 +183,7 @@ def train(
     t_last, images = time.perf_counter(), 0
     step = start
     try:
-        with _sigterm_as_exit(save_first=process_count == 1) as stop, loader:
+        with _signals_as_exit(save_first=process_count == 1) as stop, loader:
             for step in range(start, end):
                 batch = next(loader)
                 phase = config.phase(step)
@@ -202,9 +214,9 @@ def train(
                     manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
                                                "data_loader": loader.state()})
                 if stop.is_set() and done < end:
-                    bar.write(f"[lipjax] SIGTERM: saved step {done} in {manager.directory}; stopping (run again to "
-                              "resume)")
-                    raise SystemExit(128 + signal.SIGTERM)
+                    bar.write(f"[lipjax] {signal.Signals(stop.signum).name}: saved step {done} in "
+                              f"{manager.directory}; stopping (run again to resume)")
+                    raise SystemExit(128 + stop.signum)
                 if val and (done % config.eval_every == 0 or done == end):
                     # every process evaluates (the parameters live on all of them); the main one logs
                     vm = evaluate_params(config.model, state.g_params, val, max_depth)

@@ -6,9 +6,11 @@ Used by `python -m experiments.train` and `lipjax train`. Nothing is written out
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 import pathlib
+import tempfile
 from typing import Any
 
 import jax
@@ -18,6 +20,7 @@ from lipjax import model_io
 from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
+from lipjax.train.folder import check_frames
 from lipjax.train.loop import evaluate_params, export as export_model, train, validation_batches
 from lipjax.train.state import init_state
 
@@ -61,9 +64,27 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
     return mean, steps
 
 
+def check_writable(folder: str | os.PathLike, what: str) -> None:
+    """Raises OSError (one line) unless `folder` could be made and written: its nearest existing ancestor (itself,
+    when it exists) is a folder where a file can be made. Checked before a run, so that a folder the run cannot
+    write fails at once instead of after training; creates nothing."""
+    folder = pathlib.Path(folder).absolute()
+    existing = next(p for p in (folder, *folder.parents) if p.exists())
+    try:
+        if not existing.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, "a file, not a folder")
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as exc:
+        raise OSError(f"cannot write {what} into {folder} ({existing}: {exc.strerror or exc}); choose a writable "
+                      "folder") from None
+
+
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
         export_only: bool = False, average: int = 1, progress: bool = True) -> dict:
     """Trains `config` in `workdir` (resuming), then validates and, when `export` is a path, saves the model there.
+    Before training, the folder of `export` must be writable (`check_writable`) and a folder source's frames
+    readable (lipjax.train.folder.check_frames).
 
     export_only: skip training and export the latest checkpoint. average: validate and export the mean
     parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
@@ -72,6 +93,10 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     workdir = pathlib.Path(workdir)
     if average < 1:
         raise ValueError(f"--average {average}: give a number of checkpoints >= 1")
+    if export is not None:
+        check_writable(pathlib.Path(export).parent, "the model (--out / --export)")
+    if config.data.source == "folder" and not export_only:
+        check_frames(config.data)
     if export_only:
         manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
         if manager.latest_step() is None:

@@ -1,0 +1,66 @@
+"""ms per frame through the default path at three frame sizes, with the machine's matmul rate in the same run.
+
+Run by hand (never a test):
+
+    python benchmarks/speed.py [--models default,lip-fast-indoor] [--classical linear,nearest,ip_basic,colorization]
+                               [--repeats 5] [--frames synthetic]
+
+Frames: synthetic test renders (the test split, never trained on) at 256x320 and 480x640 with 200 uniform points
+(a room) and at 352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
+through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its working size (lipjax.resolution),
+host fill, solver and resizes included. "default" is the model `lipjax complete` picks for the frame.
+
+Columns per size: ms per frame (median of --repeats calls after a warm-up) and frames/s normalised to a 195 GFLOP/s
+machine: fps * 195 / (this run's 2048^3 float32 matmul rate). The rate and the 1-minute load average are printed
+first: with other processes on the cores, both the rate and the times drop.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchmarks.prox_speed import _median_ms, matmul_rate  # noqa: E402
+from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
+from lipjax.data.synthetic import render  # noqa: E402
+from lipjax.inference import complete_frame, frame_size, get_completer  # noqa: E402
+
+REFERENCE_GFLOPS = 195.0  # the rate the issues normalise frames/s to
+SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
+         ("room 480x640, 200 pts", "indoor", 480, 640, UniformSampler(200)),
+         ("street 352x1216, HDL-64", "outdoor", 352, 1216, LidarSampler.hdl64()))
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--models", default="default,lip-fast-indoor")
+    ap.add_argument("--classical", default="linear,nearest,ip_basic,colorization")
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args(argv)
+
+    _, rate = matmul_rate(10)
+    print(f"2048^3 float32 matmul: {rate:.0f} GFLOP/s; load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} "
+          "cores\n")
+    frames = []
+    for title, kind, h, w, sampler in SIZES:
+        sample = render(kind, "test", 0, h, w)
+        frames.append((title, sample.rgb, sampler(sample, 0)))
+    names = [m for m in args.models.split(",") if m] + [m for m in args.classical.split(",") if m]
+    print("| method | " + " | ".join(f"{t}: ms (fps @195)" for t, _, _ in frames) + " |")
+    print("|---|" + "---|" * len(frames))
+    for name in names:
+        cells = []
+        for _, rgb, sparse in frames:
+            completer = get_completer(None if name == "default" else name, sparse=sparse)
+            ms = _median_ms(lambda: complete_frame(completer, rgb, sparse), args.repeats)
+            h, w = frame_size(completer, sparse)
+            label = f" [{completer.name} at {h}x{w}]" if name == "default" else ""
+            cells.append(f"{ms:.0f} ({1e3 / ms * REFERENCE_GFLOPS / rate:.1f}){label}")
+        print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+
+
+if __name__ == "__main__":
+    main()

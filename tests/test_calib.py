@@ -1,0 +1,216 @@
+"""LiDAR sweep -> sparse depth: calibration readers of every format, point cloud files, and the projection checked
+against the devkit's own formula (P2 @ R0_rect @ Tr_velo_to_cam in homogeneous coordinates) on a generated rig
+whose calibration files the tests write in KITTI's text formats."""
+import numpy as np
+import pytest
+
+from lipjax.data.calib import read_calibration, read_kitti_object_calib
+from lipjax.data.errors import DatasetError
+from lipjax.data.lidar import project_sweep
+from lipjax.pointcloud import project_lidar_to_depth, read_point_cloud
+
+H, W = 40, 120
+FX, FY, CX, CY = 700.0, 690.0, 60.0, 20.0
+K = np.array([[FX, 0, CX], [0, FY, CY], [0, 0, 1]])
+# Offsets of the rectified cameras from cam0 (metres): image_2 sits ~6 cm to the left of cam0, as on KITTI, and
+# here also a little off in y and z so that every component of t = K^-1 P[:, 3] is exercised.
+OFFSETS = {0: [0, 0, 0], 1: [-0.54, 0, 0], 2: [0.06, -0.003, 0.0027], 3: [-0.47, 0.002, 0.003]}
+P = {i: K @ np.c_[np.eye(3), t] for i, t in OFFSETS.items()}
+
+
+def _rotation(ax, ay, az):
+    cx, cy, cz, sx, sy, sz = np.cos([ax, ay, az]).tolist() + np.sin([ax, ay, az]).tolist()
+    return (np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]]) @ np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+            @ np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]]))
+
+
+R0 = _rotation(0.01, -0.008, 0.005)  # a rectifying rotation of a few tenths of a degree
+# Velodyne x forward, y left, z up -> camera x right, y down, z forward; slightly tilted, 27 cm behind cam0.
+TR = np.c_[_rotation(0.02, 0.01, -0.015) @ np.array([[0, -1, 0], [0, 0, -1], [1, 0, 0]]), [0.004, -0.076, -0.27]]
+
+
+def _pad(m):
+    out = np.eye(4)
+    out[: m.shape[0], : m.shape[1]] = m
+    return out
+
+
+def _cam_from_velo(camera):
+    """Ground truth, built from the rig's parts (not from any file): [I | t_X] @ R0 @ Tr."""
+    return _pad(np.c_[np.eye(3), OFFSETS[camera]]) @ _pad(R0) @ _pad(TR)
+
+
+def _numbers(m):
+    return " ".join(f"{v:.12e}" for v in np.ravel(m))
+
+
+def write_object_calib(path):
+    lines = [f"P{i}: {_numbers(P[i])}" for i in range(4)]
+    lines += [f"R0_rect: {_numbers(R0)}", f"Tr_velo_to_cam: {_numbers(TR)}", f"Tr_imu_to_velo: {_numbers(TR)}"]
+    path.write_text("\n".join(lines) + "\n\n")
+    return path
+
+
+def write_raw_calib(folder):
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "calib_velo_to_cam.txt").write_text(
+        f"calib_time: 15-Mar-2012 11:37:16\nR: {_numbers(TR[:, :3])}\nT: {_numbers(TR[:, 3])}\n"
+        "delta_f: 0.000000e+00 0.000000e+00\ndelta_c: 0.000000e+00 0.000000e+00\n")
+    lines = ["calib_time: 09-Jan-2012 13:57:47", "corner_dist: 9.950000e-02"]
+    for i in range(4):
+        lines += [f"S_0{i}: 1.392000e+03 5.120000e+02", f"K_0{i}: {_numbers(K)}", f"D_0{i}: {_numbers(np.zeros(5))}",
+                  f"R_0{i}: {_numbers(np.eye(3))}", f"T_0{i}: {_numbers(OFFSETS[i])}",
+                  f"S_rect_0{i}: {W:.6e} {H:.6e}", f"R_rect_0{i}: {_numbers(R0 if i == 0 else np.eye(3))}",
+                  f"P_rect_0{i}: {_numbers(P[i])}"]
+    (folder / "calib_cam_to_cam.txt").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def test_every_format_gives_the_rigs_intrinsics_and_transform(tmp_path):
+    """KITTI object, tracking (no colons, R_rect / Tr_velo_cam), raw (folder or either file), odometry (Tr is
+    R0 @ Tr_velo_to_cam), and a rig as text and YAML: one answer, the ground truth, for image_2 by default."""
+    obj = write_object_calib(tmp_path / "object.txt")
+    (tmp_path / "tracking.txt").write_text("\n".join(
+        [f"P{i} {_numbers(P[i])}" for i in range(4)] + [f"R_rect {_numbers(R0)}", f"Tr_velo_cam {_numbers(TR)}"]))
+    raw = write_raw_calib(tmp_path / "2011_09_26")
+    (tmp_path / "calib.txt").write_text(
+        "\n".join([f"P{i}: {_numbers(P[i])}" for i in range(4)] + [f"Tr: {_numbers((_pad(R0) @ _pad(TR))[:3])}"]))
+    truth = _cam_from_velo(2)
+    (tmp_path / "rig.txt").write_text(f"# my rig\nK: {_numbers(K)}\nT_cam_from_lidar: {_numbers(truth)}\n")
+    (tmp_path / "rig.yaml").write_text(f"intrinsics: [{FX}, {FY}, {CX}, {CY}]\nT_cam_from_lidar:\n" + "".join(
+        f"  - [{', '.join(repr(float(v)) for v in row)}]\n" for row in truth[:3]))
+    for path in (obj, tmp_path / "tracking.txt", raw, raw / "calib_cam_to_cam.txt", raw / "calib_velo_to_cam.txt",
+                 tmp_path / "calib.txt", tmp_path / "rig.txt", tmp_path / "rig.yaml"):
+        intrinsics, t = read_calibration(path)
+        assert (intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy) == (FX, FY, CX, CY), path
+        np.testing.assert_allclose(t, truth, atol=1e-12, err_msg=str(path))
+    for camera in (0, 3):
+        np.testing.assert_allclose(read_calibration(obj, camera)[1], _cam_from_velo(camera), atol=1e-12)
+        np.testing.assert_allclose(read_calibration(raw, camera)[1], _cam_from_velo(camera), atol=1e-12)
+
+
+def test_projection_agrees_pixel_for_pixel_with_the_devkit_formula(tmp_path):
+    """2000 points (some outside the image, some behind, many sharing a pixel) projected by project_sweep from a
+    written calib file and a .bin sweep, and independently as u, v, w = P2 @ R0_rect @ Tr_velo_to_cam @ [p; 1]
+    with a nearest-w z-buffer: the same pixels, the same depths."""
+    rng = np.random.default_rng(0)
+    n = 2000
+    u, v = rng.uniform(-10, W + 10, n), rng.uniform(-5, H + 5, n)
+    z = np.where(rng.random(n) < 0.05, -rng.uniform(1, 5, n), rng.uniform(2, 60, n))  # 5 % behind the camera
+    cam2 = np.stack([(u - CX) / FX * z, (v - CY) / FY * z, z, np.ones(n)])
+    velo = (np.linalg.inv(_cam_from_velo(2)) @ cam2)[:3].T
+    sweep = np.c_[velo, rng.random(n)].astype(np.float32)  # x y z reflectance, as KITTI stores it
+    sweep.tofile(tmp_path / "000000.bin")
+    sparse, intrinsics = project_sweep(tmp_path / "000000.bin", write_object_calib(tmp_path / "calib.txt"), (H, W))
+
+    homogeneous = np.c_[sweep[:, :3].astype(np.float64), np.ones(n)].T
+    uvw = P[2] @ _pad(R0) @ _pad(TR) @ homogeneous
+    col, row, w = np.floor(uvw[0] / uvw[2] + 0.5), np.floor(uvw[1] / uvw[2] + 0.5), uvw[2]
+    inside = (w > 0) & (col >= 0) & (col < W) & (row >= 0) & (row < H)
+    expected = np.full((H, W), np.inf)
+    np.minimum.at(expected, (row[inside].astype(int), col[inside].astype(int)), w[inside])
+    expected[np.isinf(expected)] = 0
+    assert intrinsics.as_matrix().tolist() == K.tolist()
+    assert 500 < (expected > 0).sum() < inside.sum()  # many pixels, and some shared by several points
+    np.testing.assert_array_equal(sparse > 0, expected > 0)
+    np.testing.assert_allclose(sparse, expected, rtol=1e-6)
+
+
+def test_a_point_on_image_2s_optical_axis_lands_on_its_principal_point(tmp_path):
+    """P2's offset from cam0 is part of the transform: a point 7 m along image_2's optical axis lands on (cy, cx)
+    at 7 m; projected with R0_rect @ Tr_velo_to_cam alone (the offset forgotten) it lands 6 px to the left."""
+    point = (np.linalg.inv(_cam_from_velo(2)) @ [0, 0, 7.0, 1])[:3]
+    np.save(tmp_path / "axis.npy", point[None])
+    sparse, _ = project_sweep(tmp_path / "axis.npy", write_object_calib(tmp_path / "calib.txt"), (H, W))
+    assert np.argwhere(sparse).tolist() == [[CY, CX]] and sparse[int(CY), int(CX)] == pytest.approx(7.0, abs=1e-5)
+    forgotten = project_lidar_to_depth(point[None], K, _pad(R0) @ _pad(TR), (H, W))
+    assert np.argwhere(forgotten).tolist() == [[CY, CX - 6]]
+
+
+def test_point_cloud_files_bin_npy_and_pcd_read_alike(tmp_path):
+    """KITTI .bin, .npy with extra columns, and PCD ascii / binary (with other fields around x y z) give the same
+    x y z; broken files are one-line errors naming the file."""
+    xyzi = np.array([[1.5, -2.25, 0.5, 0.3], [10.0, 3.0, -1.0, 0.9], [np.nan, 0, 0, 0]], np.float32)
+    xyzi.tofile(tmp_path / "a.bin")
+    np.save(tmp_path / "a.npy", xyzi.astype(np.float64))
+    head = ("# .PCD v0.7\nVERSION 0.7\nFIELDS ring x y z intensity\nSIZE 2 4 4 4 4\nTYPE U F F F F\n"
+            "COUNT 1 1 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\n")
+    rows = "".join(f"7 {x} {y} {z} {i}\n" for x, y, z, i in xyzi.tolist())
+    (tmp_path / "ascii.pcd").write_text(head + "DATA ascii\n" + rows)
+    records = np.zeros(3, [("ring", "<u2"), ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("i", "<f4")])
+    records["x"], records["y"], records["z"], records["i"] = xyzi.T
+    (tmp_path / "binary.pcd").write_bytes((head + "DATA binary\n").encode() + records.tobytes())
+    for name in ("a.bin", "a.npy", "ascii.pcd", "binary.pcd"):
+        np.testing.assert_array_equal(read_point_cloud(tmp_path / name), xyzi[:, :3], err_msg=name)
+    xyzi.ravel()[:-1].tofile(tmp_path / "short.bin")  # 11 float32: a point cut short
+    (tmp_path / "c.pcd").write_text(head + "DATA binary_compressed\n")
+    for name, message in (("short.bin", "not a multiple of 16"), ("c.pcd", "save it as ascii or binary"),
+                          ("a.las", "unknown point cloud format")):
+        with pytest.raises(ValueError, match=message) as info:
+            read_point_cloud(tmp_path / name)
+        assert name in str(info.value) and "\n" not in str(info.value)
+
+
+def test_calibration_mistakes_are_named(tmp_path):
+    (tmp_path / "p_only.txt").write_text(f"P2: {_numbers(P[2])}\n")
+    (tmp_path / "short.txt").write_text(f"P2: {_numbers(P[2])}\nR0_rect: 1 0 0\nTr_velo_to_cam: {_numbers(TR)}\n")
+    (tmp_path / "skew.txt").write_text(
+        f"P2: {_numbers(P[2] + [[0, 3, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]])}\nR0_rect: {_numbers(R0)}\n"
+        f"Tr_velo_to_cam: {_numbers(TR)}\n")
+    for name, message in (("p_only.txt", "Not a calibration file of a known format"),
+                          ("short.txt", "3 numbers in R0_rect"), ("skew.txt", "not a camera matrix"),
+                          ("missing.txt", "Calibration file not found")):
+        with pytest.raises(DatasetError, match=message):
+            read_calibration(tmp_path / name)
+    with pytest.raises(DatasetError, match="no P5"):
+        read_kitti_object_calib(write_object_calib(tmp_path / "calib.txt"), camera=5)
+    np.save(tmp_path / "behind.npy", np.array([[-5.0, 0, 0]]))
+    with pytest.raises(ValueError, match="none of its 1 points lands in the 120x40 image"):
+        project_sweep(tmp_path / "behind.npy", tmp_path / "calib.txt", (H, W))
+
+
+def test_intrinsics_files_take_calibration_files_and_a_bare_p(tmp_path):
+    """`--intrinsics-file` (read_intrinsics_txt): a KITTI calib file (image_2 by default, or --camera), a bare 3x4
+    P; 16 numbers are a one-line error that names the accepted contents."""
+    from lipjax.data.folder import read_intrinsics_txt
+
+    (tmp_path / "p2.txt").write_text(_numbers(P[2]))
+    (tmp_path / "t.txt").write_text(_numbers(np.eye(4)))
+    obj = write_object_calib(tmp_path / "calib.txt")
+    for path in (obj, tmp_path / "p2.txt"):
+        assert read_intrinsics_txt(path).as_matrix().tolist() == K.tolist()
+    assert read_intrinsics_txt(obj, camera=3).as_matrix().tolist() == K.tolist()
+    with pytest.raises(DatasetError, match="found 16 numbers") as info:
+        read_intrinsics_txt(tmp_path / "t.txt")
+    assert "calibration file (P2: ..." in str(info.value)
+
+
+def test_project_command_writes_the_sparse_image(tmp_path, capsys):
+    """`lipjax project`: .npy equal to project_sweep's, .png at KITTI's 256 per metre, a one-line summary (none
+    with -q); a depth PNG given as the image is a one-line error."""
+    import cv2
+
+    from lipjax import cli
+
+    rng = np.random.default_rng(1)
+    cam2 = np.stack([rng.uniform(-2, 2, 300), rng.uniform(-0.5, 0.5, 300), rng.uniform(5, 30, 300), np.ones(300)])
+    sweep = np.c_[(np.linalg.inv(_cam_from_velo(2)) @ cam2)[:3].T, rng.random(300)].astype(np.float32)
+    sweep.tofile(tmp_path / "000000.bin")
+    calib = write_object_calib(tmp_path / "calib.txt")
+    cv2.imwrite(str(tmp_path / "image.png"), np.full((H, W, 3), 90, np.uint8))
+    args = ["project", "--lidar", str(tmp_path / "000000.bin"), "--calib", str(calib), "--rgb",
+            str(tmp_path / "image.png")]
+    assert cli.main(args + ["--out", str(tmp_path / "sparse.npy")]) == 0
+    expected, _ = project_sweep(tmp_path / "000000.bin", calib, (H, W))
+    np.testing.assert_array_equal(np.load(tmp_path / "sparse.npy"), expected)
+    n = int((expected > 0).sum())
+    line = capsys.readouterr().err.strip()
+    assert line == (f"wrote {tmp_path / 'sparse.npy'}: depth at {n} pixels ({100 * n / (H * W):.1f} % of {W}x{H}), "
+                    f"{expected[expected > 0].min():.2f} to {expected.max():.2f} m")
+    assert cli.main(args + ["--out", str(tmp_path / "sparse.png"), "-q"]) == 0
+    raw = cv2.imread(str(tmp_path / "sparse.png"), cv2.IMREAD_UNCHANGED)
+    assert raw.dtype == np.uint16 and capsys.readouterr().err == ""
+    np.testing.assert_array_equal(raw, np.round(expected.astype(np.float64) * 256).astype(np.uint16))
+    assert cli.main(args[:-1] + [str(tmp_path / "sparse.png"), "--out", str(tmp_path / "x.npy")]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("lipjax: error: A 16-bit single-channel PNG is a depth map") and err.count("\n") == 1
