@@ -4,11 +4,12 @@
 
 Rooms rendered at 480x640 (NYU's size) and streets at 352x1216 (KITTI's), from the test split (never trained on),
 with 50, 200 and 1,000 uniform points on the rooms and a 64-beam scan or 200 points on the streets. For each target
-spacing T (pixels) the model runs at `lipjax.resolution.working_size(shape, spacing, T)`, and the table gives the
-geometric-mean RMSE ratio to the full-size linear fill on the unsampled valid pixels (< 1: the model wins).
+spacing T (pixels) and pixel cap P the model runs at `lipjax.resolution.working_size(shape, spacing, T, P)`, and the
+table gives the geometric-mean RMSE ratio to the full-size linear fill on the unsampled valid pixels (< 1: the model
+wins).
 
-The rule, fixed before any real frame is scored: TARGET_SPACING_PX is the T with the lowest geometric mean over all
-the settings together. Real frames are scored afterwards, with that T (benchmarks/real_frames.py).
+The rule, fixed before any real frame is scored: (TARGET_SPACING_PX, MAX_WORKING_PIXELS) is the (T, P) with the
+lowest geometric mean over all the settings together. Real frames are scored afterwards, with that T (benchmarks/real_frames.py).
 """
 from __future__ import annotations
 
@@ -34,7 +35,9 @@ SETTINGS = (  # (kind, height, width, sampler spec)
     ("outdoor", 352, 1216, "lidar:hdl64"),
     ("outdoor", 352, 1216, "uniform:200"),
 )
-TARGETS_PX = (2.5, 4.0, 6.0, 8.0, 11.0, 16.0, 22.0, 32.0, 1e9)  # 1e9: always full size
+TARGETS_PX = (8.0, 11.0, 16.0, 22.0, 32.0, 1e9)  # 1e9: no spacing rule
+MAX_PIXELS = (40_000, 60_000, 100_000, 150_000, 1e12)  # 1e12: no pixel cap
+RULES = [(t, p) for t in TARGETS_PX for p in MAX_PIXELS]
 
 
 def rmse_unsampled(pred: np.ndarray, gt: np.ndarray, valid: np.ndarray, sparse: np.ndarray) -> float:
@@ -47,19 +50,26 @@ def run(model: str, frames: int, upsample: str) -> dict:
     table = {}
     for kind, h, w, spec in SETTINGS:
         dataset, sampler = SyntheticDataset(kind, "test", size=frames, height=h, width=w), sampler_from_spec(spec)
-        ratios = {t: [] for t in TARGETS_PX}
+        ratios = {rule: [] for rule in RULES}
         for sample in dataset:
             sparse = sampler(sample, 0)
             ref = rmse_unsampled(linear(sample.rgb, sparse), sample.depth, sample.valid, sparse)
-            spacing = sample_spacing_px(sparse)
-            for t in TARGETS_PX:
-                size = working_size((h, w), spacing, t)
-                pred = complete_at(completer, sample.rgb, sparse, size, upsample)
-                ratios[t].append(rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref)
+            spacing, by_size = sample_spacing_px(sparse), {}
+            for t, p in RULES:
+                size = working_size((h, w), spacing, t, p)
+                if size not in by_size:  # rules that give the same size share one run
+                    pred = complete_at(completer, sample.rgb, sparse, size, upsample)
+                    by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
+                ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"
-        table[key] = {str(t): float(np.exp(np.mean(np.log(r)))) for t, r in ratios.items()}
-        print(key, " ".join(f"{t:g}:{v:.3f}" for t, v in zip(TARGETS_PX, table[key].values())), flush=True)
+        table[key] = {_name(rule): float(np.exp(np.mean(np.log(r)))) for rule, r in ratios.items()}
+        print(key, {k: round(v, 3) for k, v in table[key].items()}, flush=True)
     return table
+
+
+def _name(rule: tuple[float, float]) -> str:
+    t, p = rule
+    return f"T={'inf' if t >= 1e9 else f'{t:g}'},P={'inf' if p >= 1e12 else f'{p / 1e3:g}k'}"
 
 
 def main(argv=None) -> None:
@@ -70,13 +80,19 @@ def main(argv=None) -> None:
     parser.add_argument("--upsample", default="bilinear", choices=("bilinear", "residual"))
     args = parser.parse_args(argv)
     table = run(args.model, args.frames, args.upsample)
-    overall = {str(t): float(np.exp(np.mean([np.log(row[str(t)]) for row in table.values()]))) for t in TARGETS_PX}
+    names = [_name(rule) for rule in RULES]
+    overall = {n: float(np.exp(np.mean([np.log(row[n]) for row in table.values()]))) for n in names}
     best = min(overall, key=overall.get)
-    print("\n| setting | " + " | ".join("full" if t == 1e9 else f"T={t:g}" for t in TARGETS_PX) + " |")
-    print("|---|" + "---|" * len(TARGETS_PX))
-    for key, row in {**table, "all (geometric mean)": overall}.items():
-        print(f"| {key} | " + " | ".join(f"{row[str(t)]:.3f}" for t in TARGETS_PX) + " |")
-    print(f"\nbest target spacing: {best} px (geometric mean {overall[best]:.3f})")
+    print("\nGeometric-mean RMSE ratio to linear over all settings; rows T (target spacing px), columns P (max pixels):")
+    print("| T \\ P | " + " | ".join(n.split(",")[1] for n in names[:len(MAX_PIXELS)]) + " |")
+    print("|---|" + "---|" * len(MAX_PIXELS))
+    for i in range(len(TARGETS_PX)):
+        row = names[i * len(MAX_PIXELS):(i + 1) * len(MAX_PIXELS)]
+        print(f"| {row[0].split(',')[0]} | " + " | ".join(f"{overall[n]:.3f}" for n in row) + " |")
+    print("\nPer setting at the best rule and with neither rule (native size):")
+    for key, row in table.items():
+        print(f"  {key}: {row[best]:.3f} (native {row['T=inf,P=inf']:.3f})")
+    print(f"\nbest rule: {best} (geometric mean {overall[best]:.3f})")
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "working_resolution.json"), "w") as f:
         json.dump({"model": args.model, "upsample": args.upsample, "frames": args.frames, "table": table, "overall": overall, "best": best}, f,

@@ -7,11 +7,15 @@ over a linear fill disappears. So the prox runs at the working size where the me
 training saw, and only there:
 
     spacing_px = sqrt(H W / n)                                n samples on an H x W frame
-    s          = min(1, TARGET_SPACING_PX / spacing_px)       the working scale (never above the frame's size)
+    s          = min(1, TARGET_SPACING_PX / spacing_px,       the working scale (never above the frame's size),
+                     sqrt(MAX_WORKING_PIXELS / (H W)))        and at most MAX_WORKING_PIXELS pixels
     (h, w)     = round(s H), round(s W), the shorter side at least MIN_WORKING_SIDE_PX
 
-Dense inputs (a 64-beam scan: ~5 px apart on a KITTI frame) already lie closer than TARGET_SPACING_PX and run at
-full size; sparse ones (200 points on 480x640: 39 px apart) run at about half size. The data-consistency step and
+Sparse inputs (200 points on 480x640: 39 px apart) run at about half size. Dense ones (a 64-beam scan, ~5 px apart
+on a KITTI frame) already lie closer than TARGET_SPACING_PX, but a KITTI-size frame still runs below full size: the
+prox's receptive field and its training frames (up to 256x320) cover a fixed number of pixels, and a scan at its
+full 352x1216 leaves the prox's field of view a narrow slice of the street (measured: the pixel cap lowers the
+error on synthetic 352x1216 streets, and it makes the frame ~4x cheaper). The data-consistency step and
 the output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every
 measured pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
 
@@ -26,6 +30,7 @@ import math
 import numpy as np
 
 TARGET_SPACING_PX = 16.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
+MAX_WORKING_PIXELS = 100_000  # the largest working size, pixels (see the module doc)
 MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
 MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
 MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cost more than it brings
@@ -39,7 +44,7 @@ def sample_spacing_px(sparse_m: np.ndarray) -> float:
 
 
 def working_size(shape: tuple[int, int], spacing_px: float, target_spacing_px: float = TARGET_SPACING_PX,
-                 min_side_px: int = MIN_WORKING_SIDE_PX) -> tuple[int, int]:
+                 max_pixels: float = MAX_WORKING_PIXELS, min_side_px: int = MIN_WORKING_SIDE_PX) -> tuple[int, int]:
     """(h, w) at which a learned prox runs on a frame of `shape` (H, W) whose samples lie `spacing_px` apart.
 
     The frame's own size when it is already at most that coarse (s >= MIN_SCALE_CHANGE) or has no samples.
@@ -47,7 +52,7 @@ def working_size(shape: tuple[int, int], spacing_px: float, target_spacing_px: f
     big_h, big_w = shape
     if not spacing_px > 0:
         raise ValueError(f"spacing_px must be > 0, got {spacing_px}")
-    s = min(1.0, target_spacing_px / spacing_px)
+    s = min(1.0, target_spacing_px / spacing_px, math.sqrt(max_pixels / (big_h * big_w)))
     s = max(s, min(1.0, min_side_px / min(big_h, big_w)))
     if s >= MIN_SCALE_CHANGE:
         return big_h, big_w

@@ -7,6 +7,7 @@ import pytest
 from lipjax import inference
 from lipjax.classical.interpolate import linear_fill
 from lipjax.resolution import (
+    MAX_WORKING_PIXELS,
     MIN_SCALE_CHANGE,
     MIN_WORKING_SIDE_PX,
     TARGET_SPACING_PX,
@@ -39,7 +40,10 @@ def test_working_size_puts_the_samples_at_the_target_spacing():
 
 
 def test_dense_samples_and_small_frames_run_at_full_size():
-    assert working_size((352, 1216), 4.7) == (352, 1216)  # a 64-beam scan: denser than the target
+    assert working_size((240, 400), 4.7) == (240, 400)  # a dense scan on a frame under the pixel cap
+    # a KITTI-size scan: the pixel cap alone sets the scale
+    h, w = working_size((352, 1216), 4.7)
+    assert h * w == pytest.approx(MAX_WORKING_PIXELS, rel=0.01) and w / h == pytest.approx(1216 / 352, rel=0.01)
     s = MIN_SCALE_CHANGE + 0.01
     assert working_size((300, 400), TARGET_SPACING_PX / s) == (300, 400)  # a resize would not pay
     # never below MIN_WORKING_SIDE_PX on the shorter side, however sparse
