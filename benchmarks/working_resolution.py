@@ -45,7 +45,7 @@ def rmse_unsampled(pred: np.ndarray, gt: np.ndarray, valid: np.ndarray, sparse: 
     return float(np.sqrt(np.mean((pred[keep] - gt[keep]) ** 2)))
 
 
-def run(model: str, frames: int, upsample: str) -> dict:
+def run(model: str, frames: int) -> dict:
     completer, linear = get_completer(model), get_method("linear")
     table = {}
     for kind, h, w, spec in SETTINGS:
@@ -58,7 +58,7 @@ def run(model: str, frames: int, upsample: str) -> dict:
             for t, p in RULES:
                 size = working_size((h, w), spacing, t, p)
                 if size not in by_size:  # rules that give the same size share one run
-                    pred = complete_at(completer, sample.rgb, sparse, size, upsample)
+                    pred = complete_at(completer, sample.rgb, sparse, size)
                     by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"
@@ -77,9 +77,8 @@ def main(argv=None) -> None:
     parser.add_argument("--model", default=None, help="default: the default model")
     parser.add_argument("--frames", type=int, default=12)
     parser.add_argument("--out", default="runs/eval/working_resolution")
-    parser.add_argument("--upsample", default="bilinear", choices=("bilinear", "residual"))
     args = parser.parse_args(argv)
-    table = run(args.model, args.frames, args.upsample)
+    table = run(args.model, args.frames)
     names = [_name(rule) for rule in RULES]
     overall = {n: float(np.exp(np.mean([np.log(row[n]) for row in table.values()]))) for n in names}
     best = min(overall, key=overall.get)
@@ -95,7 +94,7 @@ def main(argv=None) -> None:
     print(f"\nbest rule: {best} (geometric mean {overall[best]:.3f})")
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "working_resolution.json"), "w") as f:
-        json.dump({"model": args.model, "upsample": args.upsample, "frames": args.frames, "table": table, "overall": overall, "best": best}, f,
+        json.dump({"model": args.model, "frames": args.frames, "table": table, "overall": overall, "best": best}, f,
                   indent=1)
 
 

@@ -203,17 +203,15 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side))
 
 
-def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int],
-                upsample: str = "bilinear") -> np.ndarray:
+def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
-    estimate z (h, w) comes back to full size, by `upsample`:
-      "bilinear": bilinear(z);
-      "residual": F * bilinear(z / f), with F the linear fill at full size and f the one at the working size: the
-        prox's learned correction is carried over to the full-size fill, which keeps its detail near the samples.
-    Then the final x-update runs at full size: with rho -> 0 at the measured pixels (m = 1),
-    x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value exactly.
+    estimate z (h, w) is resized back (bilinear). Then the final x-update runs at full size: with rho -> 0 at the
+    measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value.
+    (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
+    bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
+    linear on 352x1216 streets with 64 beams.)
     """
     import cv2
 
@@ -222,15 +220,8 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     if (h, w) == (big_h, big_w):
         return np.asarray(completer(rgb, sparse_m), np.float32)
     small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-    small_sparse = reproject_sparse(sparse_m, (h, w))
-    small = np.asarray(completer(small_rgb, small_sparse), np.float32)
-    if upsample == "residual":
-        from lipjax.classical.interpolate import linear_fill
-
-        ratio = small / np.maximum(linear_fill(small_sparse), 1e-3)
-        dense = linear_fill(sparse_m) * cv2.resize(ratio, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
-    else:
-        dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
+    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
     return dense.astype(np.float32)
