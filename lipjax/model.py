@@ -21,7 +21,7 @@ import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
 from lipjax.fill import box_fill_with_radius, sample_radius
-from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, register_model_type
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, parameter_count, register_model_type
 from lipjax.priors.base import SharedEncoderPrior
 from lipjax.priors.network import network_preset
 
@@ -222,11 +222,6 @@ def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
         if (s > 0).any():
             out[i] = fill(s)
     return out
-
-
-def parameter_count(params: Params) -> int:
-    """Number of scalars in a parameter pytree (all iterations together)."""
-    return int(sum(np.prod(leaf.shape) for leaf in jax.tree_util.tree_leaves(params)))
 
 
 def presets(name: str) -> LIPConfig:

@@ -13,7 +13,7 @@ from lipjax.classical import (
     nearest_fill,
 )
 from lipjax.classical.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
-from lipjax.methods import CLASSICAL, get_method
+from lipjax.methods import CLASSICAL, get_completer
 
 FILLS = [CLASSICAL[name]() for name in CLASSICAL if name != "lip-wavelet"]
 
@@ -68,12 +68,12 @@ def test_invalid_inputs_raise_value_error(completer):
 
 
 def test_registry():
-    assert all(get_method(name).name == name for name in CLASSICAL)  # each method answers to its registered name
-    assert get_method("ip_basic_adaptive", radius_px=3).radius_px == 3
+    assert all(get_completer(name).name == name for name in CLASSICAL)  # each method answers to its registered name
+    assert get_completer("ip_basic_adaptive", radius_px=3).radius_px == 3
     with pytest.raises(ValueError, match="unknown model 'bicubic'"):
-        get_method("bicubic")
+        get_completer("bicubic")
     with pytest.raises(ValueError, match="learned model"):
-        get_method("lip-ad-indoor", radius_px=3)
+        get_completer("lip-ad-indoor", radius_px=3)
 
 
 def test_batch_fn_completer_wraps_a_jitted_batch_function():
