@@ -89,11 +89,17 @@ from lipjax.data.synthetic.constants import (
 from lipjax.data.synthetic.dataset import (
     SceneInfo,
     SyntheticDataset,
+    check_kind_split,
+    check_size,
+    frame_rngs,
     intrinsics_for,
     render,
     render_with_info,
     sample_id,
 )
+from lipjax.data.synthetic.renderer import render_scene
+from lipjax.data.synthetic.scene import Scene
+from lipjax.data.synthetic.scenes import build_scene
 
 __all__ = [
     "SYNTHETIC_KINDS",
@@ -111,10 +117,16 @@ __all__ = [
     "KITTI_CAMERA_HEIGHT_M",
     "RENDER_FAR_CLIP_M",
     "LABELS",
+    "Scene",
     "SceneInfo",
     "SyntheticDataset",
+    "build_scene",
+    "check_kind_split",
+    "check_size",
+    "frame_rngs",
     "intrinsics_for",
     "render",
+    "render_scene",
     "render_with_info",
     "sample_id",
 ]

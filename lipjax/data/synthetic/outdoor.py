@@ -47,7 +47,7 @@ from lipjax.data.synthetic.patterns import (
     _with_mean,
 )
 from lipjax.data.synthetic.primitives import _Ground
-from lipjax.data.synthetic.scene import _Builder, _camera_rotation, _Light, _Scene
+from lipjax.data.synthetic.scene import _Builder, _camera_rotation, Light, Scene
 
 
 def _p_facade(rng, wall: Pattern, length_u0: float) -> Pattern:
@@ -230,7 +230,7 @@ def _tree_parts(b: _Builder, rng, x, z, species, scale):
     b.spheres(cs, rng.uniform(0.5, 1.0, n) * cr * k, _VEGETATION, leaves)
 
 
-def _outdoor_scene(rng) -> _Scene:
+def outdoor_scene(rng) -> Scene:
     b = _Builder(rng)
     style = ["urban", "residential", "open"][int(rng.choice(3, p=[0.4, 0.4, 0.2]))]
     lanes = int(rng.integers(1, 3)) if style != "residential" else 1
@@ -508,9 +508,9 @@ def _outdoor_scene(rng) -> _Scene:
         glow *= 0.0 if overcast else 2.0
         return col * sky_gain + glow
 
-    return _Scene(
+    return Scene(
         prims=b.prims, cam_pos=cam, cam_R=R,
-        lights=[_Light(sun_c, direction=sun_dir, shadow_blur=1 if not overcast else 4)],
+        lights=[Light(sun_c, direction=sun_dir, shadow_blur=1 if not overcast else 4)],
         ambient=ambient, ambient_up=rng.uniform(0.2, 0.5), extent=z_end + 600.0, sky=sky,
         haze_dist=rng.uniform(300.0, 1500.0), haze_color=sky_hor * sky_gain * 0.8, max_depth=RENDER_FAR_CLIP_M,
         terrain_x=ev, shadow_range=70.0, **_camera_model(rng))

@@ -9,7 +9,7 @@ from lipjax.data.synthetic.arrays import _cols, _set_cols
 from lipjax.data.synthetic.camera import _camera_image
 from lipjax.data.synthetic.constants import _F32, _ROAD, _TERRAIN
 from lipjax.data.synthetic.primitives import _cache_hulls
-from lipjax.data.synthetic.scene import _Scene
+from lipjax.data.synthetic.scene import Scene
 from lipjax.data.synthetic.shadows import _shadows
 from lipjax.data.synthetic.surfaces import _surfaces
 from lipjax.data.synthetic.visibility import _CameraRays, _visibility
@@ -24,7 +24,7 @@ def _by_material(prims: list) -> list:
     return sorted(prims, key=lambda p: first[id(p.mat)])
 
 
-def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     prims = _by_material(scene.prims)
     _cache_hulls(prims)
     rays = _CameraRays(scene, H, W, intr)

@@ -8,7 +8,7 @@ from lipjax.data.synthetic.constants import _F32
 from lipjax.data.synthetic.culling import _rects
 from lipjax.data.synthetic.geometry import _shadow_t
 from lipjax.data.synthetic.primitives import _BOX_CORNERS
-from lipjax.data.synthetic.scene import _Light, _Scene
+from lipjax.data.synthetic.scene import Light, Scene
 
 
 def _f32_above(x: np.ndarray) -> np.ndarray:
@@ -23,7 +23,7 @@ def _f32_below(x: np.ndarray) -> np.ndarray:
     return np.where(y > x, np.nextafter(y, _F32(-np.inf)), y)
 
 
-def _shadows(scene: _Scene, light: _Light, recv, px, py, pz, nx, ny, nz, intr, H, W) -> np.ndarray:
+def _shadows(scene: Scene, light: Light, recv, px, py, pz, nx, ny, nz, intr, H, W) -> np.ndarray:
     """(H, W) float32: 0 where the light is blocked before reaching the surface point, else 1.
 
     recv (H, W) bool: the points to test; px.. (H, W) their positions and normals; intr, H, W: the camera
