@@ -66,8 +66,12 @@ Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, 
 
 Modules, each importing only those before it: `constants`; `arrays`, `noise`, `colour` (numpy helpers, procedural
 noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (intersection kernels, primitives);
-`scene` (scene description, builder); `camera` (camera model); `culling`; `indoor`, `outdoor` (scene builders);
-`visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading); `dataset` (the public entry points).
+`scene` (scene description, builder); `camera` (camera model); `culling`;
+scene elements, each a builder with its parameter ranges in a frozen dataclass: `room_materials`, `furniture`,
+`indoor` (room shell, decals, camera, furniture placement, ceiling lights); `street` (the layout), `road`,
+`vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
+`scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
+`render_scene`); `dataset` (the public entry points: seeds, checks, `render`).
 """
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,

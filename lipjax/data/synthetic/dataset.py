@@ -62,7 +62,8 @@ def _check_index(index) -> int:
 
 def check_size(height, width) -> tuple[int, int]:
     """(height, width) as ints; ValueError unless both are ints >= 8 (pixels)."""
-    if not isinstance(height, (int, np.integer)) or not isinstance(width, (int, np.integer)) or height < 8 or width < 8:
+    ints = isinstance(height, (int, np.integer)) and isinstance(width, (int, np.integer))
+    if not ints or height < 8 or width < 8:
         raise ValueError(f"height and width must be ints >= 8, got {height!r} x {width!r}")
     return int(height), int(width)
 
