@@ -3,7 +3,8 @@
 * no import circle among lipjax's modules, counting imports inside functions (they hide a circle, they do not
   remove it);
 * no function longer than `MAX_FUNCTION_LINES`;
-* the library never imports `experiments` (the shipped configs depend on the library, not the other way round).
+* the library never imports `experiments` (the shipped configs depend on the library, not the other way round);
+* a private name (`_x`) is imported only from a module of the importer's own package.
 """
 from __future__ import annotations
 
@@ -141,4 +142,18 @@ def test_library_never_imports_experiments():
         tree = ast.parse(path.read_text(), str(path))
         names = [n for node in ast.walk(tree) for n in _imported(_module_name(path), path, node, {})]
         found += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] == "experiments"]
+    assert found == []
+
+
+def test_private_names_stay_inside_their_package():
+    """e.g. lipjax.data.rendered uses lipjax.data.synthetic's public build_scene, not its builders' private names."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        name = _module_name(path)
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ImportFrom) and node.module and node.module.split(".")[0] == "lipjax":
+                private = [a.name for a in node.names if a.name.startswith("_") and not a.name.startswith("__")]
+                if private and node.module.rsplit(".", 1)[0] != package:
+                    found.append(f"{path.relative_to(ROOT)}: from {node.module} import {', '.join(private)}")
     assert found == []

@@ -62,7 +62,9 @@ Per-primitive numpy calls are batched where the arithmetic allows it without cha
 (one call per material) and scene construction (Python) remain per object.
 
 Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`, `SceneInfo`,
-`LABELS` and the constants in `__all__`.
+`LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window of the camera)
+its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`), `render_scene` (the
+scene through a camera), `check_kind_split`, `check_size`.
 
 Modules, each importing only those before it: `constants`; `arrays`, `noise`, `colour` (numpy helpers, procedural
 noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (intersection kernels, primitives);
