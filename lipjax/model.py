@@ -41,7 +41,7 @@ class LIPConfig(LearnedModel):
     """Everything that defines a LIP model except its learned parameters. Hashable (a static jit argument).
 
     Attributes:
-      prior: the proximal operator (a frozen dataclass implementing lipjax.priors.base.Prior).
+      prior: the proximal operator (a frozen dataclass with the prior interface of lipjax.priors.base).
       num_iterations: K, the number of unrolled ADMM iterations.
       shared_prox: one prox parameter set for every iteration (the paper's future work) instead of one each.
       rho_init: initial (or fixed) ADMM penalty, dimensionless, > 0; small rho trusts the measurements more.

@@ -1,11 +1,8 @@
-import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 from scipy import interpolate
 
 from lipjax.classical import (
-    BatchFnCompleter,
     ColorizationFill,
     DepthCompleter,
     LinearFill,
@@ -74,24 +71,6 @@ def test_registry():
         get_completer("bicubic")
     with pytest.raises(ValueError, match="learned model"):
         get_completer("lip-ad-indoor", radius_px=3)
-
-
-def test_batch_fn_completer_wraps_a_jitted_batch_function():
-    calls = []
-
-    @jax.jit
-    def fn(rgb, sparse):
-        calls.append(rgb.shape)  # traced once per shape
-        return sparse + rgb[..., 0]  # rgb arrives as float in [0, 1]
-
-    c = BatchFnCompleter("toy", fn)
-    s = _random_sparse(6, 7, 4)
-    rgb = _gray(6, 7, 255)
-    np.testing.assert_allclose(c(rgb, s), s + 1.0, rtol=1e-6)
-    c(rgb, s)
-    assert calls == [(1, 6, 7, 3)]
-    with pytest.raises(ValueError, match="shape"):
-        BatchFnCompleter("bad", lambda r, d: jnp.zeros((1, 3, 3)))(rgb, s)
 
 
 # ---------------------------------------------------------------- nearest
