@@ -4,7 +4,8 @@
   remove it);
 * no function longer than `MAX_FUNCTION_LINES`;
 * the library never imports `experiments` (the shipped configs depend on the library, not the other way round);
-* a private name (`_x`) is imported only from a module of the importer's own package.
+* a private name (`_x`) is imported only from a module of the importer's own package;
+* the layers of ARCHITECTURE.md: a module imports only modules of its own layer or of layers below it.
 """
 from __future__ import annotations
 
@@ -17,6 +18,28 @@ MAX_FUNCTION_LINES = 100
 # build_parser in cli.py is owned by another change (issue 24, the thin CLI); it is the only function over the limit
 # there, so cli.py is left out of the length check until that change lands.
 LENGTH_EXEMPT = {"lipjax/cli.py"}
+
+# The layers of ARCHITECTURE.md, bottom up: module-name prefix -> layer. The longest matching prefix decides.
+LAYERS = {
+    # 0: the maths and the leaves (no lipjax imports but within this layer)
+    "lipjax.operators": 0, "lipjax.admm": 0, "lipjax.fill": 0, "lipjax.priors": 0, "lipjax.interfaces": 0,
+    "lipjax.metrics": 0, "lipjax.zbuffer": 0, "lipjax.viz": 0, "lipjax.shipped": 0, "lipjax.utils": 0,
+    "lipjax.console": 0,
+    # 1: frames: data sets, samplers, the synthetic renderer, input checks, hand-crafted completers
+    "lipjax.data": 1, "lipjax.pointcloud": 1, "lipjax.inputs": 1, "lipjax.classical": 1,
+    # 2: learned models and their files
+    "lipjax.model": 2, "lipjax.networks": 2, "lipjax.model_io": 2,
+    # 3: running them: inference, the resolver, evaluation, training, export
+    "lipjax.inference": 3, "lipjax.export": 3, "lipjax.uncertainty": 3, "lipjax.methods": 3, "lipjax.evaluate": 3,
+    "lipjax.train": 3,
+    # 4: the front doors
+    "lipjax.cli": 4, "lipjax": 4,
+}
+
+
+def layer_of(module: str) -> int:
+    prefixes = [p for p in LAYERS if module == p or module.startswith(p + ".")]
+    return LAYERS[max(prefixes, key=len)]
 
 
 def _module_name(path: Path) -> str:
@@ -157,3 +180,11 @@ def test_private_names_stay_inside_their_package():
                 if private and node.module.rsplit(".", 1)[0] != package:
                     found.append(f"{path.relative_to(ROOT)}: from {node.module} import {', '.join(private)}")
     assert found == []
+
+
+def test_every_import_goes_down_the_layers():
+    graph = import_graph()
+    upward = [f"{m} (layer {layer_of(m)}) imports {t} (layer {layer_of(t)})"
+              for m, targets in sorted(graph.items()) for t in sorted(targets) if layer_of(t) > layer_of(m)]
+    assert upward == [], "\n".join(upward)
+    assert layer_of("lipjax.data.synthetic.indoor") == 1 and layer_of("lipjax.model_io") == 2  # longest prefix
