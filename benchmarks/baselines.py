@@ -42,7 +42,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
 from lipjax.data import protocols  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 from lipjax.classical.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
@@ -199,7 +199,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
 
     wanted = args.methods.split(",")
-    methods = [get_method(name) for name in wanted]  # any lipjax.methods name: classical, lip-wavelet, learned models
+    methods = [get_completer(name) for name in wanted]  # any lipjax.methods name: classical, lip-wavelet, learned
     if args.max_side:
         methods = [Downsized(m, args.max_side) for m in methods]
     print(f"methods: {[m.name for m in methods]}; LIP+Wavelet: {LIPWavelet()}")

@@ -21,7 +21,7 @@ from experiments.configs import CONFIGS  # noqa: E402
 from lipjax.data.protocols import get_protocol  # noqa: E402
 from lipjax.data.sampling import sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 
 BAND_EDGES_M = (0.0, 3.0, 5.0, 8.0, 12.0, 20.0, 40.0, 80.0)
 
@@ -38,7 +38,7 @@ def main(argv=None) -> None:
     sampler = sampler_from_spec(data.val_sampler)
     edges = [e for e in BAND_EDGES_M if e < protocol.max_depth_m] + [protocol.max_depth_m]
     names = args.methods.split(",")
-    methods = {name: get_method(name) for name in names}
+    methods = {name: get_completer(name) for name in names}
     squared = {name: np.zeros(len(edges) - 1) for name in names}  # summed (1/km)^2 per band
     counts = np.zeros(len(edges) - 1)
     for i in range(len(dataset)):

@@ -31,8 +31,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from benchmarks.baselines import _png_depth, _rgb, load_kitti, load_middlebury, load_nyu  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.inference import complete_at, complete_frame, frame_size, get_completer  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.inference import complete_at, complete_frame, frame_size  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
 
 KITTI_FRACTION = 0.3  # of the valid pixels, the second KITTI input
@@ -85,7 +85,7 @@ def main(argv=None) -> None:
     ap.add_argument("--classical", default="ip_basic,colorization", help="comma-separated classical methods")
     args = ap.parse_args(argv)
 
-    linear, classical = get_method("linear"), [get_method(m) for m in args.classical.split(",") if m]
+    linear, classical = get_completer("linear"), [get_completer(m) for m in args.classical.split(",") if m]
     rows = []
     for group, sample, sparse, input_name in frames_and_inputs(os.path.abspath(args.realdata)):
         completer = get_completer(args.model, sparse=sparse)

@@ -30,7 +30,7 @@ from baselines import INDOOR_RANGE_M, OUTDOOR_RANGE_M, load_real  # noqa: E402
 from lipjax import model_io  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.evaluate import evaluate  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 
 
 def real_settings(root: str) -> list[tuple[list, object, tuple[float, float]]]:
@@ -93,13 +93,13 @@ def main(argv=None) -> None:
     if not os.path.isdir(root):
         ap.error(f"no real frames at {root}; give --realdata DIR")
     settings = real_settings(root)
-    linear = frame_rmse(get_method("linear"), settings)
+    linear = frame_rmse(get_completer("linear"), settings)
     rows = []
     for run, path in models:
         seen = model_io.metadata(path).get("images_seen")
         if seen is None:
             ap.error(f"{path} records no images_seen; export it with `experiments.train --export`")
-        rmse = frame_rmse(get_method(path), settings)
+        rmse = frame_rmse(get_completer(path), settings)
         ratios = {k: rmse[k] / linear[k] for k in linear}
         rows.append({"run": run, "model": path, "images_seen": int(seen), "rmse_m": rmse, "ratios": ratios,
                      "wins": sum(r < 1.0 for r in ratios.values()),

@@ -26,7 +26,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from benchmarks.prox_speed import _median_ms, matmul_rate  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import render  # noqa: E402
-from lipjax.inference import complete_frame, frame_size, get_completer  # noqa: E402
+from lipjax.inference import complete_frame, frame_size  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 
 REFERENCE_GFLOPS = 195.0  # the rate the issues normalise frames/s to
 SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),

@@ -36,7 +36,7 @@ from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluat
 from lipjax import uncertainty  # noqa: E402
 from lipjax.data import protocols  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 
 INDOOR_RANGE_M = (0.0, 10.0)
 OUTDOOR_RANGE_M = (0.0, 80.0)
@@ -84,7 +84,7 @@ def run(settings, method_names):
     print("|---|---|---|---|---|---|---|---|---|")
     for title, scene, frames, sampler, depth_range in settings:
         for name in method_names:
-            method = get_method(name.format(scene=scene))
+            method = get_completer(name.format(scene=scene))
             per_frame = [frame_rows(method, s, sampler, depth_range) for s in frames]
             x = np.concatenate([f for f, _ in per_frame])
             err = np.concatenate([e for _, e in per_frame])
@@ -101,7 +101,7 @@ def calibrate(settings, method_names):
     design, target, above_err, above_z = [], [], [], []
     for _, scene, frames, sampler, depth_range in settings:
         for name in method_names:
-            method = get_method(name.format(scene=scene))
+            method = get_completer(name.format(scene=scene))
             x, err = map(np.concatenate, zip(*(frame_rows(method, s, sampler, depth_range) for s in frames)))
             r, spread, height, z = x[:, 0], x[:, 1], x[:, 2], np.maximum(x[:, 3], 1e-3)
             supported = height <= 1.0

@@ -24,8 +24,8 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from lipjax.data.sampling import sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_at, get_completer  # noqa: E402
-from lipjax.methods import get_method  # noqa: E402
+from lipjax.inference import complete_at  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
 from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
 
 SETTINGS = (  # (kind, height, width, sampler spec)
@@ -46,7 +46,7 @@ def rmse_unsampled(pred: np.ndarray, gt: np.ndarray, valid: np.ndarray, sparse: 
 
 
 def run(model: str, frames: int) -> dict:
-    completer, linear = get_completer(model), get_method("linear")
+    completer, linear = get_completer(model), get_completer("linear")
     table = {}
     for kind, h, w, spec in SETTINGS:
         dataset, sampler = SyntheticDataset(kind, "test", size=frames, height=h, width=w), sampler_from_spec(spec)

@@ -16,12 +16,12 @@ import numpy as np
 from lipjax.data.sample import Sample
 from lipjax.evaluate import EvalResult, evaluate, markdown_table
 from lipjax.inference import Completer
-from lipjax.methods import get_method
+from lipjax.methods import get_completer
 
 
 def load_methods(methods: Sequence[str]) -> dict[str, Any]:
     """Completers by name (lipjax.methods), loaded once and shared by the tables and figures of an experiment."""
-    return {name: get_method(name) for name in methods}
+    return {name: get_completer(name) for name in methods}
 
 
 def evaluate_methods(

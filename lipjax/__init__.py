@@ -8,9 +8,11 @@ Depth is in metres everywhere; 0 means "no measurement".
     model = lipjax.load_model("lip-cnn-outdoor"); dense = model(rgb, sparse)
 """
 from lipjax.admm import Trajectory, unrolled_admm
-from lipjax.inference import Completer, InputError, complete, load_model
-from lipjax.model import LIPConfig, parameter_count, presets
-from lipjax.model_io import available as available_models
+from lipjax.inference import Completer, InputError, load_model
+from lipjax.interfaces import parameter_count
+from lipjax.methods import complete
+from lipjax.model import LIPConfig, presets
+from lipjax.shipped import available as available_models
 from lipjax.operators import dual_update, x_update
 from lipjax.priors.network import NetworkPrior, network_preset
 from lipjax.utils import enable_compilation_cache

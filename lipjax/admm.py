@@ -3,7 +3,7 @@ r"""Unrolled ADMM for the depth-completion LIP (paper eqs. 5-9), as one `jax.lax
 For k = 0 .. K-1 (scaled form):
 
     x_{k+1} = (w * y + rho_k * (z_k - u_k)) / (w + rho_k)     # operators.x_update, exact argmin of eq. 6
-    z_{k+1} = G_k(x_{k+1} + u_k, R)                           # the proximal operator (eq. 9), any Prior
+    z_{k+1} = G_k(x_{k+1} + u_k, R)                           # the proximal operator (eq. 9), any prior
     u_{k+1} = u_k + x_{k+1} - z_{k+1}                         # operators.dual_update
 
 and the returned estimate is one more x-update, x_out = x_update(y, w, z_K, u_K, rho_{K-1}), so that the output

@@ -120,8 +120,9 @@ def _model_max_depth(completer) -> float:
 def _cmd_complete(args) -> int:
     from lipjax.data.folder import check_one_depth_format, output_format, pair_frames, read_frame, write_depth
     from lipjax.data.lidar import read_lidar_frame
-    from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, frame_size, get_completer
+    from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, frame_size
     from lipjax.inputs import scene_reason
+    from lipjax.methods import get_completer
     from lipjax.pointcloud import backproject_rgbd, write_ply
     from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
 
@@ -253,7 +254,7 @@ def _cmd_evaluate(args) -> int:
     from lipjax.data.sampling import sampler_from_spec
     from lipjax.data.sources import NO_PROTOCOL
     from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, open_eval_source, save_json
-    from lipjax.inference import get_completer
+    from lipjax.methods import get_completer
 
     if args.source is None and (args.root is not None or args.raw_root is not None):
         raise CLIError("--root and --raw-root go with --source NAME; --data takes the folder itself")
@@ -318,7 +319,7 @@ def _cmd_evaluate(args) -> int:
 
 def _cmd_export(args) -> int:
     from lipjax.export import export_completer, save_exported
-    from lipjax.inference import get_completer
+    from lipjax.methods import get_completer
 
     completer = get_completer(args.model, args.iterations)
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None

@@ -1,7 +1,8 @@
 """The jit-compiled inference entry point: `Completer` (a model with its parameters); inputs checked by lipjax.inputs.
 
-Also the frame-level helpers the command line calls: `get_completer` (a model by name, path or object, or the
-default model), and `complete_frame`, which can run a large frame at a reduced size (`max_side`).
+Also `load_model` (a saved model by name or path), `default_model` (the shipped default of a scene), and
+`complete_frame`, which can run a large frame at a reduced size (`max_side`). Names of every kind of completer
+(learned, classical, a path) resolve in lipjax.methods.get_completer.
 
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
 same size, and returns dense depth in metres. The solver is compiled once per (config, input shape): jit caches
@@ -20,13 +21,12 @@ import jax
 import numpy as np
 
 from lipjax import model_io
-from lipjax.inputs import DEFAULT_MODELS, InputError, check_inputs, suggest_scene  # noqa: F401  (lipjax.InputError)
+from lipjax.inputs import InputError, check_inputs  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import LearnedModel
 from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
+from lipjax.shipped import DEFAULT_MODEL, DEFAULT_MODELS
 from lipjax.zbuffer import splat_nearest
-
-DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
 
 
 @functools.lru_cache(maxsize=None)
@@ -114,51 +114,6 @@ def default_model(scene: str = "indoor") -> Completer:
     warnings.warn(f"no trained weights shipped ({name!r} is not in `lipjax models`): using an UNTRAINED "
                   "model, whose output is only a smooth fill of the samples; pass a model name or path", stacklevel=2)
     return Completer.random()
-
-
-def get_completer(model: Any = None, iterations: int | None = None, sparse: np.ndarray | None = None):
-    """A completer: `model` is a completer object, any `lipjax.methods` name (shipped model, saved model path,
-    lip-wavelet, nearest, linear, ip_basic, colorization) or None: `default_model`, outdoor when the `sparse`
-    depth given (metres) looks outdoor (`lipjax.inputs.suggest_scene`). With `iterations`, a LIP model runs only
-    its first K iterations."""
-    if model is None:
-        completer = default_model("indoor" if sparse is None else suggest_scene(sparse))
-    elif isinstance(model, (str, os.PathLike)):
-        from lipjax.methods import get_method  # lipjax.methods imports this module
-
-        completer = get_method(os.fspath(model))
-    else:
-        completer = model
-    if iterations is not None:
-        if not isinstance(completer, Completer):
-            raise ValueError(f"iterations apply to LIP models; {getattr(completer, 'name', model)!r} is not one")
-        completer = completer.with_iterations(iterations)
-    return completer
-
-
-def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_uncertainty: float | None = None,
-             return_uncertainty: bool = False):
-    """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
-
-    `model`: a completer, a shipped model name, a saved model path or any `lipjax.methods` name ("linear",
-    "ip_basic", ...); by default the shipped default model, indoor or outdoor as the samples suggest
-    (`get_completer`). A learned model runs at the working size of the samples' spacing (`complete_frame`). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
-    (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
-    """
-    completer = get_completer(model, sparse=sparse)
-    rgb, sparse = np.asarray(rgb), np.asarray(sparse, np.float32)
-    if sparse.ndim == 3:
-        dense = np.stack([complete_frame(completer, c, y) for c, y in zip(rgb, sparse)])
-    else:
-        dense = complete_frame(completer, rgb, sparse)
-    if max_uncertainty is None and not return_uncertainty:
-        return dense
-    from lipjax.uncertainty import drop_uncertain, expected_error
-
-    u = expected_error(sparse, dense)
-    if max_uncertainty is not None:
-        dense = drop_uncertain(dense, u, max_uncertainty)
-    return (dense, u) if return_uncertainty else dense
 
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.

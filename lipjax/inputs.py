@@ -29,15 +29,14 @@ import warnings
 
 import numpy as np
 
+from lipjax.shipped import DEFAULT_MODELS, available
+
 # A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
 # The deepest indoor samples (Kinect, NYU v2); also the range of the indoor models (config.max_depth_m, 85 m outdoor).
 INDOOR_DEPTH_M = 10.0
 # Input whose median sample depth exceeds this is outdoor data (no room is that deep).
 OUTDOOR_MEDIAN_M = 12.0
-# The default shipped model per scene (lipjax.inference.DEFAULT_MODEL is the indoor one).
-# Indoor: the shared-encoder model, ahead of lip-ad-indoor on Table I and on the real NYU frames (README Results).
-DEFAULT_MODELS = {"indoor": "lip-fast-indoor", "outdoor": "lip-ad-outdoor"}
 # Sparsest training input of the shipped models, samples per pixel (experiments/configs.py: indoor uniform:100 on
 # 256x320, outdoor uniform:200 on 128x416); a warning below a quarter of it.
 TRAINED_MIN_DENSITY = {"indoor": 100 / (256 * 320), "outdoor": 200 / (128 * 416)}
@@ -141,12 +140,10 @@ def scene_reason(sparse: np.ndarray) -> tuple[str, str]:
 
 def _other_model(name: str, scene: str) -> str:
     """The shipped model of `scene` named like `name` (lip-cnn-indoor -> lip-cnn-outdoor), else the default."""
-    from lipjax import model_io  # imported here: the rest of inputs.py stays free of JAX
-
     other = {"indoor": "outdoor", "outdoor": "indoor"}[scene]
     shipped_like = name.endswith(f"-{other}") and "/" not in name and "\\" not in name
     twin = name[: -len(other)] + scene
-    return twin if shipped_like and twin in model_io.available() else DEFAULT_MODELS[scene]
+    return twin if shipped_like and twin in available() else DEFAULT_MODELS[scene]
 
 
 def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model",

@@ -39,6 +39,11 @@ def register_model_type(name: str):
     return register
 
 
+def parameter_count(params: Params) -> int:
+    """Number of scalars in a parameter pytree (all iterations together)."""
+    return int(sum(np.prod(leaf.shape) for leaf in jax.tree_util.tree_leaves(params)))
+
+
 def model_type_name(config: "LearnedModel | type") -> str:
     """The registered type name of a model config (or of its class)."""
     kind = config if isinstance(config, type) else type(config)

@@ -1,21 +1,27 @@
-"""The one registry of depth-completion methods: every method by name, for the library, experiments and the CLI.
+"""The one registry of depth-completion methods, and the one resolver that turns a name, path or object into a
+completer: for the library, experiments and the CLI. It sits above everything it builds (lipjax.inference,
+lipjax.classical), and nothing it builds imports it.
 
-    get_method("lip-ad-indoor")        a shipped learned model (lipjax/weights), or any saved model path
-    get_method("lip-wavelet")          LIP with the hand-crafted wavelet soft-thresholding prox (no training)
-    get_method("linear")               a hand-crafted fill (CLASSICAL): nearest, linear, ip_basic,
-    get_method("ip_basic", extrapolate=True)   ip_basic_multiscale, ip_basic_adaptive, colorization; keyword
+    get_completer("lip-ad-indoor")     a shipped learned model (lipjax/weights), or any saved model path
+    get_completer("lip-wavelet")       LIP with the hand-crafted wavelet soft-thresholding prox (no training)
+    get_completer("linear")            a hand-crafted fill (CLASSICAL): nearest, linear, ip_basic,
+    get_completer("ip_basic", extrapolate=True)   ip_basic_multiscale, ip_basic_adaptive, colorization; keyword
                                        arguments override the method's settings
+    get_completer(None, sparse=s)      the shipped default model of the scene the samples suggest
+    get_completer(obj)                 a completer object, returned as is
 
 All are `DepthCompleter`s: completer(rgb (H,W,3) uint8, sparse (H,W) float32 metres) -> (H,W) float32 m, with
 a `name`. Learned models are `lipjax.inference.Completer`s over a `lipjax.interfaces.LearnedModel` (model types by
-name: `lipjax.interfaces.MODEL_TYPES`, the table model files use).
+name: `lipjax.interfaces.MODEL_TYPES`, the table model files use). `complete` is the one-call front end.
 """
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
 
-from lipjax import model_io
+import numpy as np
+
 from lipjax.classical import (
     ColorizationFill,
     IPBasicAdaptiveFill,
@@ -26,7 +32,10 @@ from lipjax.classical import (
 )
 from lipjax.classical.completer import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
-from lipjax.inference import load_model
+from lipjax.inference import Completer, complete_frame, default_model, load_model
+from lipjax.inputs import suggest_scene
+from lipjax.shipped import available
+from lipjax.uncertainty import drop_uncertain, expected_error
 
 SCENES = ("indoor", "outdoor")
 
@@ -42,16 +51,58 @@ CLASSICAL: dict[str, Callable[..., DepthCompleter]] = {
 }
 
 
-def get_method(name: str, **settings: Any) -> DepthCompleter:
-    """A completer by name (see the module docstring); `settings` only for the hand-crafted methods."""
-    if name in CLASSICAL:
-        return CLASSICAL[name](**settings)
-    if settings:
-        raise ValueError(f"{name!r} is a learned model: its settings are in its model file, not keyword arguments")
-    return load_model(name)
+def get_completer(model: Any = None, iterations: int | None = None, sparse: np.ndarray | None = None,
+                  **settings: Any) -> DepthCompleter:
+    """A completer (see the module docstring).
+
+    Args:
+      model: a completer object; a name (CLASSICAL, a shipped model) or a saved model path; or None for
+        `lipjax.inference.default_model`, outdoor when `sparse` looks outdoor (`lipjax.inputs.suggest_scene`).
+      iterations: run a LIP model's first K iterations only.
+      sparse: (H, W) or (B, H, W) metres, only to choose the default model's scene.
+      settings: keyword settings of a hand-crafted method; learned models keep theirs in their model file.
+    """
+    if settings and not (isinstance(model, str) and model in CLASSICAL):
+        raise ValueError(f"settings apply to hand-crafted methods; {model!r} is a learned model (its settings are in "
+                         "its model file) or a completer object")
+    if model is None:
+        completer = default_model("indoor" if sparse is None else suggest_scene(sparse))
+    elif isinstance(model, (str, os.PathLike)):
+        name = os.fspath(model)
+        completer = CLASSICAL[name](**settings) if name in CLASSICAL else load_model(name)
+    else:
+        completer = model
+    if iterations is not None:
+        if not isinstance(completer, Completer):
+            raise ValueError(f"iterations apply to LIP models; {getattr(completer, 'name', model)!r} is not one")
+        completer = completer.with_iterations(iterations)
+    return completer
 
 
 def available_methods(scene: str) -> list[str]:
     """Names of the methods that can run for a scene now: shipped learned models first, then the hand-crafted."""
-    learned = [m for m in model_io.available() if m.endswith(f"-{scene}")]
+    learned = [m for m in available() if m.endswith(f"-{scene}")]
     return learned + list(CLASSICAL)
+
+
+def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_uncertainty: float | None = None,
+             return_uncertainty: bool = False):
+    """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
+
+    `model`: anything `get_completer` takes; by default the shipped default model, indoor or outdoor as the samples
+    suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`).
+    With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
+    (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
+    """
+    completer = get_completer(model, sparse=sparse)
+    rgb, sparse = np.asarray(rgb), np.asarray(sparse, np.float32)
+    if sparse.ndim == 3:
+        dense = np.stack([complete_frame(completer, c, y) for c, y in zip(rgb, sparse)])
+    else:
+        dense = complete_frame(completer, rgb, sparse)
+    if max_uncertainty is None and not return_uncertainty:
+        return dense
+    u = expected_error(sparse, dense)
+    if max_uncertainty is not None:
+        dense = drop_uncertain(dense, u, max_uncertainty)
+    return (dense, u) if return_uncertainty else dense

@@ -4,8 +4,8 @@ Evaluated pixels of one image (the evaluation mask E):
 
     E = valid & isfinite(gt) & (min_depth_m < gt <= max_depth_m)
 
-(lower bound exclusive, upper inclusive: the convention of `lipjax.data.protocols.Protocol.eval_mask`, whose
-named protocols carry the ranges to pass here, e.g. NYU (0, 10] m, outdoor (0, 80] m).
+(lower bound exclusive, upper inclusive). The named protocols of lipjax.data.protocols carry the ranges to pass
+here (Protocol.min_depth_m, max_depth_m), e.g. NYU (0, 10] m, outdoor (0, 80] m.
 
 Per image, with d = prediction and g = ground truth (metres), over the pixels of E:
 
@@ -42,7 +42,7 @@ many images each mean is over.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -176,36 +176,6 @@ def compute_metrics(
     return out
 
 
-def compute_metrics_batch(
-    pred: Any,
-    gt: Any,
-    valid: Any,
-    sparse: Any | None = None,
-    *,
-    min_depth_m: float = DEFAULT_MIN_DEPTH_M,
-    max_depth_m: float = DEFAULT_MAX_DEPTH_M,
-    pred_floor_m: float = DEFAULT_PRED_FLOOR_M,
-) -> list[dict[str, float]]:
-    """`compute_metrics` for each image of a batch: pred, gt, valid, sparse are (B, H, W). Returns B dicts."""
-    pred, gt, valid = np.asarray(pred), np.asarray(gt), np.asarray(valid)
-    if pred.ndim != 3:
-        raise ValueError(f"pred must be (B, H, W), got shape {pred.shape}")
-    if sparse is not None:
-        sparse = np.asarray(sparse)
-    return [
-        compute_metrics(
-            pred[i],
-            gt[i],
-            valid[i],
-            None if sparse is None else sparse[i],
-            min_depth_m=min_depth_m,
-            max_depth_m=max_depth_m,
-            pred_floor_m=pred_floor_m,
-        )
-        for i in range(pred.shape[0])
-    ]
-
-
 class MetricAggregator:
     """Accumulates per-image metric dicts and returns the per-image-then-mean data-set metrics.
 
@@ -227,10 +197,6 @@ class MetricAggregator:
                 self._pixel_counts[k] = self._pixel_counts.get(k, 0) + int(val)
             else:
                 self._values.setdefault(k, []).append(float(val))
-
-    def add_many(self, metrics: Iterable[Mapping[str, float]]) -> None:
-        for m in metrics:
-            self.add(m)
 
     def means(self) -> dict[str, float]:
         """Mean over images of each metric, ignoring NaNs; NaN if no image had that metric."""

@@ -21,7 +21,7 @@ import numpy as np
 
 from lipjax.admm import Trajectory, unrolled_admm
 from lipjax.fill import box_fill_with_radius, sample_radius
-from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, register_model_type
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, LearnedModel, parameter_count, register_model_type
 from lipjax.priors.base import SharedEncoderPrior
 from lipjax.priors.network import network_preset
 
@@ -41,7 +41,7 @@ class LIPConfig(LearnedModel):
     """Everything that defines a LIP model except its learned parameters. Hashable (a static jit argument).
 
     Attributes:
-      prior: the proximal operator (a frozen dataclass implementing lipjax.priors.base.Prior).
+      prior: the proximal operator (a frozen dataclass with the prior interface of lipjax.priors.base).
       num_iterations: K, the number of unrolled ADMM iterations.
       shared_prox: one prox parameter set for every iteration (the paper's future work) instead of one each.
       rho_init: initial (or fixed) ADMM penalty, dimensionless, > 0; small rho trusts the measurements more.
@@ -222,11 +222,6 @@ def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
         if (s > 0).any():
             out[i] = fill(s)
     return out
-
-
-def parameter_count(params: Params) -> int:
-    """Number of scalars in a parameter pytree (all iterations together)."""
-    return int(sum(np.prod(leaf.shape) for leaf in jax.tree_util.tree_leaves(params)))
 
 
 def presets(name: str) -> LIPConfig:

@@ -23,8 +23,7 @@ import numpy as np
 from lipjax.interfaces import MODEL_TYPES, model_type_name
 from lipjax.model import LIPConfig
 from lipjax.priors.network import NetworkPrior
-
-WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
+from lipjax.shipped import WEIGHTS_DIR, available
 
 
 class ModelFileError(ValueError):
@@ -102,11 +101,6 @@ def save(stem: str | os.PathLike, config, params, metadata: dict | None = None) 
     _atomic_write(_with_suffix(stem, ".msgpack"), flax.serialization.msgpack_serialize(params))
     doc = {"config": config_to_dict(config), "metadata": metadata or {}}
     _atomic_write(_with_suffix(stem, ".json"), json.dumps(doc, indent=2).encode())
-
-
-def available() -> list[str]:
-    """Names of the models shipped with the package."""
-    return sorted(p.stem for p in WEIGHTS_DIR.glob("*.msgpack") if p.with_suffix(".json").exists())
 
 
 def resolve(name_or_path: str | os.PathLike) -> pathlib.Path:

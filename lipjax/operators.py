@@ -22,16 +22,6 @@ import jax
 import jax.numpy as jnp
 
 
-def forward(mask: jax.Array, x: jax.Array) -> jax.Array:
-    """A x = m * x: keeps the depth at the sampled pixels, zero elsewhere."""
-    return mask * x
-
-
-def adjoint(mask: jax.Array, y: jax.Array) -> jax.Array:
-    """A^T y = m * y (A is diagonal, hence self-adjoint)."""
-    return mask * y
-
-
 def x_update(y: jax.Array, mask: jax.Array, z: jax.Array, u: jax.Array, rho) -> jax.Array:
     """Exact minimiser of eq. 6: argmin_x 1/2 ||y - A x||_W^2 + rho/2 ||x - z + u||^2.
 

@@ -103,46 +103,6 @@ def _as_rgb(image: np.ndarray) -> np.ndarray:
     return image
 
 
-def panel(images: Sequence[np.ndarray] | Sequence[Sequence[np.ndarray]], titles: Sequence[str] | None = None,
-          pad: int = 4, background: int = 255) -> np.ndarray:
-    """Tiles images side by side (one row) or in a grid (a list of rows) into one uint8 RGB image.
-
-    Args:
-      images: uint8 (H, W, 3) or (H, W) images, or a list of such rows. Cells are as large as the largest image
-        of their column / row; smaller images are centred.
-      titles: optional column titles, written above the first row (cv2 Hershey font, black).
-      pad: pixels between cells and around the border.
-    """
-    if len(images) == 0:
-        raise ValueError("panel needs at least one image")
-    rows = [list(r) for r in images] if isinstance(images[0], (list, tuple)) else [list(images)]
-    rows = [[_as_rgb(im) for im in row] for row in rows]
-    ncols = max(len(r) for r in rows)
-    col_w = [max((r[c].shape[1] for r in rows if c < len(r)), default=0) for c in range(ncols)]
-    row_h = [max(im.shape[0] for im in r) for r in rows]
-    title_h = 0
-    font, scale, thick = cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1
-    if titles:
-        title_h = max(cv2.getTextSize(t, font, scale, thick)[0][1] for t in titles) + 8
-    height = pad + title_h + sum(h + pad for h in row_h)
-    width = pad + sum(w + pad for w in col_w)
-    out = np.full((height, width, 3), background, np.uint8)
-    x0s = np.cumsum([pad] + [w + pad for w in col_w[:-1]])
-    if titles:
-        for c, text in enumerate(list(titles)[:ncols]):
-            (tw, th), _ = cv2.getTextSize(text, font, scale, thick)
-            x = int(x0s[c] + max(0, (col_w[c] - tw) // 2))
-            cv2.putText(out, text, (x, pad + th + 2), font, scale, (0, 0, 0), thick, cv2.LINE_AA)
-    y = pad + title_h
-    for r, row in enumerate(rows):
-        for c, im in enumerate(row):
-            h, w = im.shape[:2]
-            yy, xx = y + (row_h[r] - h) // 2, int(x0s[c]) + (col_w[c] - w) // 2
-            out[yy:yy + h, xx:xx + w] = im
-        y += row_h[r] + pad
-    return out
-
-
 def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
     """Writes a uint8 RGB (H, W, 3) or grey (H, W) image as PNG (cv2 wants BGR; converted here)."""
     image = np.asarray(image)
@@ -163,7 +123,7 @@ def comparison_row(rgb: np.ndarray, sparse_m: np.ndarray, gt_m: np.ndarray, vali
     """One row of a Fig.-3-like figure: RGB | sparse input | GT | for each method, prediction and error map.
 
     Depths share one fixed colour range [min_m, max_m]; errors share [0, max_error_m]. Methods keep the mapping's
-    order. Use with `panel` or `save_panel`, titled by `comparison_titles(predictions)`.
+    order. Use with `save_panel`, titled by `comparison_titles(predictions)`.
     """
     valid = (np.asarray(gt_m) > 0) if valid is None else np.asarray(valid, bool)
     gt_shown = np.where(valid, gt_m, 0)
@@ -179,7 +139,7 @@ def save_panel(path: str | os.PathLike, rows: Sequence[Sequence[np.ndarray]], ti
     """Writes a grid of images as a matplotlib figure (PNG / PDF / SVG by extension), with titles and colour bars.
 
     Args:
-      rows: rows of uint8 images (see `panel`); all rows the same length.
+      rows: rows of uint8 (H, W, 3) or grey (H, W) images, all of one size; all rows the same length.
       titles: column titles; row_labels: one label per row (left side).
       colorbars: (label, vmin, vmax, cmap) colour bars drawn under the grid, e.g. ("depth [m]", 0, 10, "turbo").
     """

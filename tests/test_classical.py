@@ -1,11 +1,8 @@
-import jax
-import jax.numpy as jnp
 import numpy as np
 import pytest
 from scipy import interpolate
 
 from lipjax.classical import (
-    BatchFnCompleter,
     ColorizationFill,
     DepthCompleter,
     LinearFill,
@@ -13,7 +10,7 @@ from lipjax.classical import (
     nearest_fill,
 )
 from lipjax.classical.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
-from lipjax.methods import CLASSICAL, get_method
+from lipjax.methods import CLASSICAL, get_completer
 
 FILLS = [CLASSICAL[name]() for name in CLASSICAL if name != "lip-wavelet"]
 
@@ -68,30 +65,12 @@ def test_invalid_inputs_raise_value_error(completer):
 
 
 def test_registry():
-    assert all(get_method(name).name == name for name in CLASSICAL)  # each method answers to its registered name
-    assert get_method("ip_basic_adaptive", radius_px=3).radius_px == 3
+    assert all(get_completer(name).name == name for name in CLASSICAL)  # each method answers to its registered name
+    assert get_completer("ip_basic_adaptive", radius_px=3).radius_px == 3
     with pytest.raises(ValueError, match="unknown model 'bicubic'"):
-        get_method("bicubic")
+        get_completer("bicubic")
     with pytest.raises(ValueError, match="learned model"):
-        get_method("lip-ad-indoor", radius_px=3)
-
-
-def test_batch_fn_completer_wraps_a_jitted_batch_function():
-    calls = []
-
-    @jax.jit
-    def fn(rgb, sparse):
-        calls.append(rgb.shape)  # traced once per shape
-        return sparse + rgb[..., 0]  # rgb arrives as float in [0, 1]
-
-    c = BatchFnCompleter("toy", fn)
-    s = _random_sparse(6, 7, 4)
-    rgb = _gray(6, 7, 255)
-    np.testing.assert_allclose(c(rgb, s), s + 1.0, rtol=1e-6)
-    c(rgb, s)
-    assert calls == [(1, 6, 7, 3)]
-    with pytest.raises(ValueError, match="shape"):
-        BatchFnCompleter("bad", lambda r, d: jnp.zeros((1, 3, 3)))(rgb, s)
+        get_completer("lip-ad-indoor", radius_px=3)
 
 
 # ---------------------------------------------------------------- nearest

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import lipjax
+import lipjax.methods
 from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
@@ -225,7 +226,7 @@ def test_the_default_model_is_named_with_its_reason_and_depth_scale_on_npy_warns
                                                                                 monkeypatch):
     """Without --model, one line names the model chosen and why (none with -q); --depth-scale with .npy depth and
     .npy output warns that it is ignored."""
-    monkeypatch.setattr(lipjax.inference, "default_model", lambda scene: model[1])
+    monkeypatch.setattr(lipjax.methods, "default_model", lambda scene: model[1])
     args = ["complete", "--rgb", frame["rgb"], "--depth", frame["npy"], "--out", str(tmp_path / "out.npy")]
     assert cli.main(args) == 0
     median = np.median(frame["sparse_array"][frame["sparse_array"] > 0])

@@ -1,11 +1,10 @@
 import json
 import math
 
-import jax
 import numpy as np
 import pytest
 
-from lipjax.classical import BatchFnCompleter, NearestFill
+from lipjax.classical import NearestFill
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.evaluate import EvalResult, evaluate, markdown_table, save_json
 from lipjax.metrics import compute_metrics
@@ -85,13 +84,6 @@ def test_evaluate_rejects_wrong_shapes_and_empty_datasets():
         evaluate(lambda rgb, s: s[:-1], _dataset(1), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
     with pytest.raises(ValueError, match="empty"):
         evaluate(NearestFill(), [], _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
-
-
-def test_jitted_batch_model_as_completer():
-    model = BatchFnCompleter("jit_identity", jax.jit(lambda rgb, sparse: sparse))
-    res = evaluate(model, _dataset(2), _sampler, min_depth_m=0.0, max_depth_m=100.0, progress=False)
-    assert res.name == "jit_identity"
-    assert res.metrics["mae_vs_input_m"] == 0.0 and res.metrics["mae_sampled_m"] == 0.0
 
 
 def test_markdown_table_and_json(tmp_path):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import lipjax
-from lipjax import inference, model_io
+from lipjax import inference, methods, model_io
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 
@@ -117,7 +117,7 @@ def test_save_keeps_a_dotted_stem_exactly(tmp_path, completer):
 def test_complete_takes_any_method_name():
     rgb, sparse = _inputs()
     np.testing.assert_array_equal(lipjax.complete(rgb, sparse, model="linear"),
-                                  lipjax.complete(rgb, sparse, model=inference.get_completer("linear")))
+                                  lipjax.complete(rgb, sparse, model=methods.get_completer("linear")))
     assert lipjax.complete(rgb, sparse, model="nearest").shape == sparse.shape
 
 
@@ -128,6 +128,6 @@ def test_reproject_sparse_and_complete_frame_keep_measured_values(completer):
     small = inference.reproject_sparse(sparse, (4, 4))
     assert small[0, 0] == 3.0 and small[3, 3] == 1.25 and np.count_nonzero(small) == 2
     rgb, sparse = _inputs(h=24, w=32)
-    dense = inference.complete_frame(inference.get_completer("linear"), rgb, sparse, max_side=16)
+    dense = inference.complete_frame(methods.get_completer("linear"), rgb, sparse, max_side=16)
     assert dense.shape == (24, 32) and dense.dtype == np.float32
     np.testing.assert_array_equal(dense[sparse > 0], sparse[sparse > 0])

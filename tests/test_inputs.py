@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import lipjax
-from lipjax import inference
+from lipjax import inference, methods
 from lipjax.inputs import InputError, check_for_model, check_inputs, is_lidar_pattern, suggest_scene
 
 INDOOR, OUTDOOR = (10.0, "lip-cnn-indoor"), (85.0, "lip-cnn-outdoor")
@@ -111,9 +111,9 @@ def test_lidar_pattern_and_scene():
 
 
 def test_default_model_follows_the_input():
-    assert inference.get_completer(sparse=_lidar(20.0)).name == "lip-ad-outdoor"
-    assert inference.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-fast-indoor"
-    assert inference.get_completer().name == "lip-fast-indoor"
+    assert methods.get_completer(sparse=_lidar(20.0)).name == "lip-ad-outdoor"
+    assert methods.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-fast-indoor"
+    assert methods.get_completer().name == "lip-fast-indoor"
 
 
 def test_the_completer_checks_against_its_range():

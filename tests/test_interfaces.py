@@ -7,7 +7,7 @@ import lipjax.networks  # noqa: F401  (registers the end-to-end network types)
 from lipjax import methods
 from lipjax.interfaces import MODEL_TYPES, SCENE_MAX_DEPTH_M, LearnedModel, model_type_name, register_model_type
 from lipjax.model import LIPConfig, presets
-from lipjax.networks import PRESETS
+from lipjax.networks import PRESETS, baseline_preset
 
 
 def test_every_model_type_is_a_learned_model_and_named_both_ways():
@@ -29,7 +29,7 @@ def test_a_type_name_cannot_be_taken_twice_and_unknown_types_are_named():
 
 def test_scene_depth_ranges_reach_the_models():
     assert presets("small-outdoor").max_depth_m == SCENE_MAX_DEPTH_M["outdoor"]
-    assert PRESETS["unet"]["tiny"].preset("tiny", SCENE_MAX_DEPTH_M["indoor"]).max_depth_m == 10.0
+    assert baseline_preset("unet", "tiny", SCENE_MAX_DEPTH_M["indoor"]).max_depth_m == 10.0
 
 
 def test_the_registry_names_every_hand_crafted_method():

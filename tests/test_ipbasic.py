@@ -15,10 +15,9 @@ from lipjax.classical.ipbasic import (
     ip_basic_multiscale,
 )
 from lipjax.classical.nearest import nearest_fill
-from lipjax.methods import get_method
 from lipjax.data.sampling import LidarSampler
 from lipjax.data.synthetic.dataset import render
-from lipjax.methods import get_method
+from lipjax.methods import get_completer
 
 # ---------------------------------------------------------------- reference transcription (slow, obvious)
 
@@ -268,12 +267,12 @@ def test_bad_inputs_raise_one_line_value_errors():
 
 
 def test_registered_by_name():
-    assert isinstance(get_method("ip_basic"), IPBasicFill)
-    assert isinstance(get_method("ip_basic_multiscale"), IPBasicMultiscaleFill)
-    assert isinstance(get_method("ip_basic_adaptive"), IPBasicAdaptiveFill)
-    assert get_method("ip_basic", extrapolate=True).extrapolate
+    assert isinstance(get_completer("ip_basic"), IPBasicFill)
+    assert isinstance(get_completer("ip_basic_multiscale"), IPBasicMultiscaleFill)
+    assert isinstance(get_completer("ip_basic_adaptive"), IPBasicAdaptiveFill)
+    assert get_completer("ip_basic", extrapolate=True).extrapolate
     rgb = np.zeros(FRAMES[1].shape + (3,), np.uint8)
-    np.testing.assert_array_equal(get_method("ip_basic")(rgb, FRAMES[1]), ip_basic(FRAMES[1]))
+    np.testing.assert_array_equal(get_completer("ip_basic")(rgb, FRAMES[1]), ip_basic(FRAMES[1]))
 
 
 # ---------------------------------------------------------------- the density-adaptive variant

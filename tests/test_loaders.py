@@ -181,7 +181,7 @@ def test_kitti_depth_completion(tmp_path):
     crop = Protocol("tiny", (BottomCrop(8, 12),), (8, 12), 0.0, 80.0)
     cropped = crop(s)
     real = KittiLidarInput(ds, crop)(cropped)
-    assert np.array_equal(real, frame.lidar[4:, 2:14]) and np.array_equal(frame.apply_protocol(crop).lidar, real)
+    assert np.array_equal(real, frame.lidar[4:, 2:14]) and np.array_equal(crop.apply_to_depth(frame.lidar), real)
     sub = KittiLidarInput(ds, crop, num_points=5)(cropped, seed=1)
     assert np.count_nonzero(sub) == 5 and np.array_equal(sub[sub > 0], real[sub > 0])
     assert np.array_equal(sub, KittiLidarInput(ds, crop, num_points=5)(cropped, seed=1))

@@ -1,10 +1,9 @@
 import math
 
-import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from lipjax.metrics import METRIC_NAMES, MetricAggregator, compute_metrics, compute_metrics_batch, evaluation_mask
+from lipjax.metrics import METRIC_NAMES, MetricAggregator, compute_metrics, evaluation_mask
 
 # A 2x2 image with errors known by hand: +0.5 m, 0, -1 m, 0.
 GT = np.array([[1.0, 2.0], [4.0, 5.0]], np.float32)
@@ -116,7 +115,8 @@ def test_per_image_then_mean_averaging():
     ma = compute_metrics(gt + 1, gt, va)
     mb = compute_metrics(gt, gt, ~va)
     agg = MetricAggregator()
-    agg.add_many([ma, mb])
+    agg.add(ma)
+    agg.add(mb)
     means = agg.means()
     assert means["mae_m"] == pytest.approx(0.5)  # pooled over pixels it would be 0.25
     assert agg.counts()["n_eval_px"] == 4  # pixel counts are summed
@@ -129,18 +129,3 @@ def test_rmse_is_mean_of_per_image_rmse():
     agg.add(compute_metrics(np.array([[4.0, 1.0]]), gt, gt > 0))  # rmse sqrt(9/2)
     agg.add(compute_metrics(np.array([[1.0, 1.0]]), gt, gt > 0))  # rmse 0
     assert agg.means()["rmse_m"] == pytest.approx(math.sqrt(4.5) / 2)
-
-
-def test_batch_helper_matches_per_image_and_accepts_jax_arrays():
-    rng = np.random.default_rng(1)
-    gt = rng.uniform(1, 5, (3, 4, 5)).astype(np.float32)
-    valid = rng.uniform(size=gt.shape) > 0.3
-    pred = gt + rng.normal(0, 0.2, gt.shape).astype(np.float32)
-    sparse = np.where(rng.uniform(size=gt.shape) > 0.7, gt, 0).astype(np.float32)
-    batch = compute_metrics_batch(jnp.asarray(pred), jnp.asarray(gt), jnp.asarray(valid), jnp.asarray(sparse),
-                                  max_depth_m=4.0)
-    for i in range(3):
-        single = compute_metrics(pred[i], gt[i], valid[i], sparse[i], max_depth_m=4.0)
-        assert batch[i].keys() == single.keys()
-        for k in single:
-            assert batch[i][k] == pytest.approx(single[k], nan_ok=True)

@@ -147,8 +147,8 @@ def test_one_supervised_train_step_through_the_shared_train_loop():
 
 
 def test_presets_by_name_and_invalid_configs_are_clear_errors():
-    assert UNet.preset("small", max_depth_m=85.0) == UNet(base_width=14, max_depth_m=85.0)
-    assert CSPN.preset("tiny") == PRESETS["cspn"]["tiny"]
+    assert baseline_preset("unet", "small", max_depth_m=85.0) == UNet(base_width=14, max_depth_m=85.0)
+    assert baseline_preset("cspn", "tiny") == PRESETS["cspn"]["tiny"]
     with pytest.raises(ValueError, match="decoder widths"):
         SparseToDense(width_multiplier=0.375)
     with pytest.raises(ValueError, match="max_depth_m"):

@@ -67,7 +67,8 @@ def test_extrinsics_move_points_into_the_camera_frame():
     T = np.eye(4)
     T[:3, :3], T[:3, 3] = r, t
     np.testing.assert_allclose(project_lidar_to_depth(lidar, K, T, (H, W)), depth, rtol=1e-5)
-    np.testing.assert_allclose(project_lidar_to_depth(lidar, K.as_matrix(), T[:3], (H, W)), depth, rtol=1e-5)
+    K3 = np.array([[K.fx, 0.0, K.cx], [0.0, K.fy, K.cy], [0.0, 0.0, 1.0]])  # a (3, 3) matrix works as well
+    np.testing.assert_allclose(project_lidar_to_depth(lidar, K3, T[:3], (H, W)), depth, rtol=1e-5)
 
 
 @pytest.mark.parametrize("order", [(0, 1, 2), (2, 1, 0), (1, 2, 0)])

@@ -14,12 +14,12 @@ from lipjax.data.protocols import (
     CenterCrop,
     Protocol,
     Resize,
-    apply_protocol,
     get_protocol,
     nearest_indices,
     tartanair_split,
 )
 from lipjax.data.sample import Intrinsics, Sample
+from lipjax.metrics import evaluation_mask
 
 K_NYU = Intrinsics(518.8579, 519.46961, 325.58245, 253.73617)
 K_KITTI = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
@@ -63,7 +63,9 @@ def test_depth_ranges():
     assert PROTOCOLS["nyu_paper"].max_depth_m == 10.0 and PROTOCOLS["nyu_ma"].max_depth_m == 10.0
     assert PROTOCOLS["kitti_paper"].max_depth_m == 80.0
     assert PROTOCOLS["kitti_selection"].max_depth_m == math.inf
-    mask = PROTOCOLS["nyu_paper"].eval_mask(np.array([0.0, 5.0, 10.0, 10.5]), np.array([True, True, True, False]))
+    p = PROTOCOLS["nyu_paper"]
+    mask = evaluation_mask(np.array([0.0, 5.0, 10.0, 10.5]), np.array([True, True, True, False]),
+                           min_depth_m=p.min_depth_m, max_depth_m=p.max_depth_m)
     assert mask.tolist() == [False, True, True, False]
 
 
@@ -145,7 +147,7 @@ def test_apply_to_depth_matches_sample_geometry():
         if name == "nyu_ma":
             sample = index_sample(480, 640, K_NYU, holes=True)
         assert np.array_equal(p.apply_to_depth(sample.depth), p(sample).depth)
-    assert apply_protocol("nyu_ma", sample).shape == (228, 304)
+    assert get_protocol("nyu_ma")(sample).shape == (228, 304)
 
 
 def test_steps_errors_and_nearest_indices():

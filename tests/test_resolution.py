@@ -7,6 +7,7 @@ import pytest
 
 from lipjax import inference
 from lipjax.classical.interpolate import linear_fill
+from lipjax.methods import get_completer
 from lipjax.resolution import (
     MAX_WORKING_PIXELS,
     MIN_SCALE_CHANGE,
@@ -85,7 +86,7 @@ def test_frame_size_follows_the_samples_for_learned_models_only():
     h, w = inference.frame_size(model, sparse)
     assert (h, w) == working_size((240, 320), sample_spacing_px(sparse))
     assert (h, w) != (240, 320)
-    assert inference.frame_size(inference.get_completer("linear"), sparse) == (240, 320)
+    assert inference.frame_size(get_completer("linear"), sparse) == (240, 320)
     assert inference.frame_size(model, sparse, max_side=160) == (120, 160)
     with pytest.raises(inference.InputError, match="max_side 3"):
         inference.frame_size(model, sparse, max_side=3)

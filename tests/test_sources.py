@@ -309,7 +309,7 @@ def test_lipjax_evaluate_reads_a_source_as_training_does(tmp_path, capsys):
     from lipjax import cli
     from lipjax.data.protocols import get_protocol
     from lipjax.evaluate import evaluate
-    from lipjax.inference import get_completer
+    from lipjax.methods import get_completer
 
     root = make_nyu(tmp_path / "nyu")
     assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none", "--model", "linear",
@@ -394,7 +394,7 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
     from lipjax.evaluate import evaluate, open_eval_source
     from lipjax.data.sampling import sampler_from_spec
     from lipjax.data.synthetic import sample_id
-    from lipjax.inference import get_completer
+    from lipjax.methods import get_completer
 
     out = render_to_disk("outdoor", "val", 2, tmp_path / "r", height=H, width=W, workers=1, progress=False)
     assert cli.main(["evaluate", "--source", "rendered", "--root", str(out), "--model", "nearest", "--quiet",

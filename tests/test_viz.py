@@ -47,18 +47,6 @@ def test_colorize_sparse_enlarges_points_nearest_on_top():
     np.testing.assert_array_equal(img[0, 0], 0)
 
 
-def test_panel_tiles_rows_with_titles():
-    a = np.zeros((10, 20, 3), np.uint8)
-    b = np.full((8, 12), 200, np.uint8)  # grey is accepted and centred in a cell of the column's width
-    out = viz.panel([[a, b], [a, a]], titles=["left", "right"], pad=2)
-    assert out.dtype == np.uint8 and out.shape[1] == 2 + 20 + 2 + 20 + 2
-    assert out.shape[0] > 2 + 10 + 2 + 10 + 2  # plus a title band
-    one_row = viz.panel([a, a], pad=0)
-    assert one_row.shape == (10, 40, 3)
-    with pytest.raises(ValueError, match="uint8"):
-        viz.panel([a.astype(np.float32)])
-
-
 def test_comparison_row_and_figure(tmp_path):
     rng = np.random.default_rng(0)
     gt = rng.uniform(1, 9, (16, 20)).astype(np.float32)
@@ -67,8 +55,10 @@ def test_comparison_row_and_figure(tmp_path):
     row = viz.comparison_row(rgb, sparse, gt, None, {"A": gt + 0.1, "B": gt}, max_m=10, max_error_m=0.5)
     titles = viz.comparison_titles(["A", "B"])
     assert len(row) == len(titles) == 7 and all(im.shape == (16, 20, 3) for im in row)
-    viz.write_png(tmp_path / "grid.png", viz.panel([row], titles))
-    assert cv2.imread(str(tmp_path / "grid.png")).shape[2] == 3
+    viz.write_png(tmp_path / "rgb.png", row[0])
+    np.testing.assert_array_equal(cv2.imread(str(tmp_path / "rgb.png"))[..., ::-1], rgb)  # written as RGB
+    with pytest.raises(ValueError, match="uint8"):
+        viz.save_panel(tmp_path / "bad.png", [[gt]])
     viz.save_panel(tmp_path / "fig.png", [row, row], titles, row_labels=["1", "2"],
                    colorbars=[("depth [m]", 0, 10, "turbo"), ("error [m]", 0, 0.5, "jet")])
     fig = cv2.imread(str(tmp_path / "fig.png"))

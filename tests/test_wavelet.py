@@ -10,11 +10,19 @@ from lipjax.priors.wavelet import (
     dwt2,
     idwt2,
     soft_threshold,
-    transform_matrix,
     wavelet_shrink,
 )
 
 WAVELETS = ["haar", "db2"]
+
+
+def transform_matrix(shape: tuple[int, int], levels: int, wavelet: str = "haar") -> np.ndarray:
+    """The (H W, H W) matrix of `dwt2` (rows: approximation first, then details finest level first)."""
+    h, w = shape
+    eye = jnp.eye(h * w, dtype=jnp.float32).reshape(h * w, h, w)
+    approx, details = dwt2(eye, levels, wavelet)
+    parts = [approx.reshape(h * w, -1)] + [d.reshape(h * w, -1) for lvl in details for d in lvl]
+    return np.asarray(jnp.concatenate(parts, axis=1)).T
 
 
 @pytest.mark.parametrize("wavelet", WAVELETS)

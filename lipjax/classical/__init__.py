@@ -1,5 +1,5 @@
-"""Hand-crafted depth completers, all behind the one `DepthCompleter` interface (lipjax.classical.completer);
-by name through the one registry, lipjax.methods:
+"""Hand-crafted depth completers: no learned parameters, all `DepthCompleter`s (lipjax.classical.completer); by
+name through the one resolver, lipjax.methods.get_completer:
 
     completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
@@ -11,14 +11,16 @@ by name through the one registry, lipjax.methods:
   IPBasicAdaptiveFill     IP-Basic with density-adaptive kernels, fills every pixel ignores RGB   ipbasic.py
   ColorizationFill        Levin et al. 2004 colourisation (NYU toolbox), exact at   RGB-guided    colorization.py
                           samples
+  LIPWavelet              the paper's LIP+Wavelet baseline: the ADMM solver with    ignores RGB   lip_wavelet.py
+                          the wavelet soft-thresholding prox (lipjax.priors.wavelet)
 
-Each raises ValueError for an empty sparse map, mismatched shapes, NaN / inf or negative depth. The LIP+Wavelet
-baseline is a prior for the ADMM solver, in lipjax.priors.wavelet.
+Each checks its inputs with lipjax.inputs.check_frame: InputError (a ValueError) for an empty sparse map,
+mismatched shapes, NaN / inf or negative depth.
 """
 from __future__ import annotations
 
 from lipjax.classical.colorization import ColorizationFill, colorization_fill
-from lipjax.classical.completer import BatchFnCompleter, DepthCompleter
+from lipjax.classical.completer import DepthCompleter
 from lipjax.classical.interpolate import LinearFill, linear_fill
 from lipjax.classical.ipbasic import (
     IPBasicAdaptiveFill,
@@ -29,10 +31,8 @@ from lipjax.classical.ipbasic import (
     ip_basic_multiscale,
 )
 from lipjax.classical.nearest import NearestFill, nearest_fill
-from lipjax.inputs import check_frame
 
 __all__ = [
-    "BatchFnCompleter",
     "ColorizationFill",
     "DepthCompleter",
     "IPBasicAdaptiveFill",
@@ -40,7 +40,6 @@ __all__ = [
     "IPBasicMultiscaleFill",
     "LinearFill",
     "NearestFill",
-    "check_frame",
     "colorization_fill",
     "ip_basic",
     "ip_basic_adaptive",

@@ -9,7 +9,7 @@ Formats (`read_calibration` tells them apart by their keys; "key: numbers" lines
     KITTI object / tracking   P0..P3 (3x4), R0_rect (3x3; tracking: R_rect), Tr_velo_to_cam (3x4; Tr_velo_cam)
     KITTI raw                 a date folder (or either file in it) with calib_velo_to_cam.txt (R: 9, T: 3) and
                               calib_cam_to_cam.txt (R_rect_00: 9, P_rect_0X: 12)
-    KITTI odometry            calib.txt: P0..P3, Tr (3x4) (lipjax.data.kitti_odometry.read_odometry_calib)
+    KITTI odometry            calib.txt: P0..P3, Tr (3x4) (read_odometry_calib)
     any rig (text or .yaml)   K (9 numbers, or 3 rows of 3) or intrinsics (fx fy cx cy), and T_cam_from_lidar
                               (12 or 16 numbers: 3x4 or 4x4), pixels and metres:
                                   K: 721.5 0 609.6 0 721.5 172.9 0 0 1
@@ -149,12 +149,23 @@ def read_rig_calib(path: str | os.PathLike) -> tuple[Intrinsics, np.ndarray]:
     return intrinsics, transform
 
 
+def read_odometry_calib(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
+    """(intrinsics of image_<camera>, (4, 4) T_cam_from_velodyne, metres) from a sequence's calib.txt: P_X and Tr
+    (velodyne -> cam0), T = [I | K^-1 P_X[:, 3]] @ Tr (lipjax.data.calib)."""
+    rows = read_key_values(path)
+    try:
+        p, tr = rows[f"P{camera}"].reshape(3, 4), rows["Tr"].reshape(3, 4)
+        intrinsics, t = camera_from_projection(p)
+    except (KeyError, ValueError) as e:
+        raise dataset_error(f"Cannot read KITTI odometry calibration ({e})", path) from None
+    # P_X = K [I | t]: image_X's offset from the rectified cam0 (a baseline along x, in metres).
+    return intrinsics, rigid(translation=t) @ rigid(tr)
+
+
 def read_calibration(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
     """(intrinsics of the camera's image, pixels; (4, 4) T_cam_from_lidar, metres) from any format of the module
     docstring, told apart by its keys. `camera`: the KITTI camera (2 = left colour, 3 = right colour); a rig file
     describes one camera and ignores it."""
-    from lipjax.data.kitti_odometry import read_odometry_calib
-
     path = Path(path)
     if path.is_dir() or path.name in RAW_FILES:
         return read_kitti_raw_calib(path if path.is_dir() else path.parent, camera)

@@ -96,10 +96,6 @@ class KittiFrame:
             raise ValueError(f"{self.sample.id}: lidar must be float32 {self.sample.shape}, "
                              f"got {self.lidar.dtype} {self.lidar.shape}")
 
-    def apply_protocol(self, protocol) -> "KittiFrame":
-        """The frame after a protocols.Protocol: same crop for the GT sample and the LiDAR scan."""
-        return KittiFrame(protocol(self.sample), protocol.apply_to_depth(self.lidar))
-
 
 class _KittiBase:
     """Shared indexing: subclasses fill self.ids (and self.target) and implement rgb, ground_truth, lidar,

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lipjax.data.calib import camera_from_projection, read_key_values, rigid
+from lipjax.data.calib import read_odometry_calib
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import natural_key, read_rgb
 from lipjax.data.sample import Intrinsics, Sample
@@ -28,20 +28,6 @@ KITTI_ODOMETRY_LAYOUT = """\
 <root>/sequences/<SS>/velodyne/<NNNNNN>.bin
 <root>/sequences/<SS>/calib.txt   (P2: ..., Tr: ...)"""
 KITTI_ODOMETRY_SOURCE = "KITTI odometry benchmark (colour images, Velodyne laser data, calibration files)"
-
-
-def read_odometry_calib(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
-    """(intrinsics of image_<camera>, (4, 4) T_cam_from_velodyne, metres) from a sequence's calib.txt: P_X and Tr
-    (velodyne -> cam0), T = [I | K^-1 P_X[:, 3]] @ Tr (lipjax.data.calib)."""
-    rows = read_key_values(path, KITTI_ODOMETRY_LAYOUT, KITTI_ODOMETRY_SOURCE)
-    try:
-        p, tr = rows[f"P{camera}"].reshape(3, 4), rows["Tr"].reshape(3, 4)
-        intrinsics, t = camera_from_projection(p)
-    except (KeyError, ValueError) as e:
-        raise dataset_error(f"Cannot read KITTI odometry calibration ({e})", path, KITTI_ODOMETRY_LAYOUT,
-                            KITTI_ODOMETRY_SOURCE) from None
-    # P_X = K [I | t]: image_X's offset from the rectified cam0 (a baseline along x, in metres).
-    return intrinsics, rigid(translation=t) @ rigid(tr)
 
 
 def read_velodyne_bin(path: str | os.PathLike) -> np.ndarray:

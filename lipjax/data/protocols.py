@@ -179,19 +179,6 @@ class Protocol:
             raise ValueError(f"protocol {self.name!r} produced {depth.shape[:2]}, expected {self.output_size}")
         return depth
 
-    def eval_mask(self, gt: np.ndarray, valid: np.ndarray | None = None) -> np.ndarray:
-        """Pixels that count in evaluation: valid & min_depth_m < gt <= max_depth_m. Any shape; returns bool."""
-        gt = np.asarray(gt)
-        mask = (gt > self.min_depth_m) & (gt <= self.max_depth_m)
-        return mask if valid is None else mask & np.asarray(valid, dtype=bool)
-
-
-def apply_protocol(protocol: Protocol | str, sample: Sample) -> Sample:
-    """Applies a protocol (or its registry name) to a Sample."""
-    if isinstance(protocol, str):
-        protocol = get_protocol(protocol)
-    return protocol(sample)
-
 
 # The NYU paper crop: see the module docstring for why 464x580 (aspect 0.8, drops the white border).
 NYU_RAW_SIZE = (480, 640)

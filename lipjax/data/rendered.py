@@ -85,20 +85,17 @@ def window_corner(spec: RenderSpec, index: int) -> tuple[int, int]:
 
 def _render_frame(spec: RenderSpec, index: int) -> tuple[np.ndarray, np.ndarray]:
     """(rgb (h, w, 3) uint8, depth (h, w) float32 metres) of one frame (its window when spec.window is set)."""
-    from lipjax.data.synthetic import intrinsics_for, render, sample_id
-    from lipjax.data.synthetic.dataset import _indoor_scene, _outdoor_scene, _render, _seed
+    from lipjax.data.synthetic import build_scene, frame_rngs, intrinsics_for, render, render_scene, sample_id
 
     if spec.window is None:
         sample = render(spec.kind, spec.split, index, spec.height, spec.width)
         return sample.rgb, sample.depth
     top, left = window_corner(spec, index)
-    seed = _seed(spec.kind, spec.split, index)
-    scene_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
-    noise_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
-    scene = _indoor_scene(scene_rng) if spec.kind == "indoor" else _outdoor_scene(scene_rng)
+    scene_rng, noise_rng = frame_rngs(spec.kind, spec.split, index)
+    scene = build_scene(spec.kind, scene_rng)
     intr = intrinsics_for(spec.kind, spec.height, spec.width).cropped(top, left)
     with np.errstate(all="ignore"):
-        rgb, depth, _ = _render(scene, spec.window[0], spec.window[1], intr, noise_rng)
+        rgb, depth, _ = render_scene(scene, spec.window[0], spec.window[1], intr, noise_rng)
     sample = Sample.from_depth(rgb, depth, intr, sample_id(spec.kind, spec.split, index))
     return sample.rgb, sample.depth
 
@@ -161,11 +158,11 @@ def render_to_disk(kind: str, split: str, count: int, out: str | os.PathLike, *,
     Returns the folder. Re-running with the same arguments finishes an interrupted render; different
     arguments in a folder that holds a render are an error.
     """
-    from lipjax.data.synthetic.dataset import _check_kind_split, _check_size
+    from lipjax.data.synthetic import check_kind_split, check_size
 
-    _check_kind_split(kind, split)
+    check_kind_split(kind, split)
     default_h, default_w = TRAINING_SIZES[kind]
-    height, width = _check_size(height or default_h, width or default_w)
+    height, width = check_size(height or default_h, width or default_w)
     if count < 1 or shard_size < 1:
         raise ValueError(f"count and shard_size must be >= 1, got {count} and {shard_size}")
     if window is not None and not (8 <= window[0] <= height and 8 <= window[1] <= width):

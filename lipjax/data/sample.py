@@ -34,10 +34,6 @@ class Intrinsics:
             (self.cy + 0.5) * scale_y - 0.5,
         )
 
-    def as_matrix(self) -> np.ndarray:
-        """(3, 3) float64 camera matrix K."""
-        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
-
 
 @dataclasses.dataclass(frozen=True)
 class Sample:

@@ -112,7 +112,7 @@ def _own_points(spec: str) -> int | None:
         raise ValueError(f"sampler spec {spec!r}: expected 'input' or 'input:N' with an integer N") from None
 
 
-def _folder_root(root: Path, split: str) -> tuple[Path, bool]:
+def folder_split_root(root: Path, split: str) -> tuple[Path, bool]:
     """(folder holding rgb/ and depth/ for this split, whether the split is a folder of its own)."""
     if (root / "train").is_dir() and (root / "val").is_dir():
         return root / split, True
@@ -176,7 +176,7 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     if source == "folder":
         from lipjax.data.folder import FolderDataset
 
-        folder, own_split = _folder_root(Path(root), split)
+        folder, own_split = folder_split_root(Path(root), split)
         dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}")
         own = FolderInput(os.fspath(folder / "sparse"), data.depth_scale, dataset.id_prefix)
         if own_split:

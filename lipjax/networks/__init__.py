@@ -21,7 +21,7 @@ Choices shared with lipjax.priors.network, and why:
   downloaded here, so every network is trained from scratch.
 - Up-projection is Laina et al.'s, through its sub-pixel "fast up-convolution" (lipjax.priors.network.UpProjection).
 
-Presets (PRESETS[model][size], or `<Class>.preset(size, max_depth_m)`): "paper" (the published widths), "small"
+Presets (PRESETS[model][size], or `baseline_preset(model, size, max_depth_m)`): "paper" (the published widths), "small"
 (about LIP's small preset over 3 iterations, ~1.5 M parameters, trainable on a 2-core CPU), "tiny" (tests).
 Their parameter counts are asserted in tests/test_networks.py.
 """

@@ -7,8 +7,8 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
-from lipjax.interfaces import LearnedModel, model_type_name
-from lipjax.model import parameter_count
+from lipjax.interfaces import LearnedModel, parameter_count
+
 
 def group_norm(channels: int) -> nn.GroupNorm:
     """GroupNorm with up to 8 groups; the group count must divide the channels (12 channels -> 4 groups)."""
@@ -58,13 +58,6 @@ class NetworkModel(LearnedModel):
 
     def parameter_count(self, params) -> int:
         return parameter_count(params)
-
-    @classmethod
-    def preset(cls, size: str, max_depth_m: float = 10.0):
-        """A preset by size ('paper', 'small', 'tiny') with the depth normalisation of the target scenes (metres)."""
-        from lipjax.networks import baseline_preset  # the presets table imports every network module
-
-        return baseline_preset(model_type_name(cls), size, max_depth_m)
 
 
 def check_max_depth(max_depth_m: float) -> None:

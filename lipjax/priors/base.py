@@ -2,35 +2,28 @@
 
 A prior is the z-update of ADMM (paper eqs. 7-9):  z_{k+1} = prox(x_{k+1} + u_k, R).
 It knows nothing about the sampling operator A; the solver knows nothing about what the prior is.
+
+A prior is a hashable frozen dataclass (a static jit argument; lipjax.model.LIPConfig.prior) with:
+
+    max_depth_m: float       the depth range of the scenes it is made for, metres (lipjax.interfaces)
+    init(key, image_shape, guidance_channels=3) -> params
+                             parameters of ONE iteration's operator, for (H, W) images and a guidance image of
+                             `guidance_channels` channels (RGB, possibly with extra ones such as the sampling mask)
+    apply(params, v, rgb) -> z
+                             v: (B, H, W) float32 metres (x_{k+1} + u_k); rgb: (B, H, W, C) float32 in [0, 1], the
+                             guidance image; z: (B, H, W) float32 metres
+
+(lipjax.priors.network.NetworkPrior, lipjax.priors.wavelet.WaveletPrior). A prior whose guidance is encoded once per
+frame implements `SharedEncoderPrior` below instead (lipjax.priors.guided.GuidedPrior).
 """
 from __future__ import annotations
 
 import abc
-from typing import Any, NamedTuple, Protocol
+from typing import Any, NamedTuple
 
 import jax
 
 Params = Any  # a pytree of arrays
-
-
-class Prior(Protocol):
-    """A proximal operator z = prox(v, rgb) with (possibly empty) parameters, made for depths up to `max_depth_m`.
-
-    Shapes and units:
-      v:   (B, H, W) float32 depth in metres (x_{k+1} + u_k).
-      rgb: (B, H, W, C) float32 in [0, 1]: the RGB guidance image (C = 3), possibly with extra channels.
-      returns z: (B, H, W) float32 depth in metres.
-    """
-
-    max_depth_m: float  # the depth range of the scenes it is made for, metres (lipjax.interfaces)
-
-    def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> Params:
-        """Parameters of ONE iteration's operator for images of size image_shape = (H, W) and a guidance image
-        of `guidance_channels` channels (RGB, possibly with extra channels such as the sampling mask)."""
-        ...
-
-    def apply(self, params: Params, v: jax.Array, rgb: jax.Array) -> jax.Array:
-        ...
 
 
 class EncodedGuidance(NamedTuple):

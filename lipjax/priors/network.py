@@ -122,7 +122,7 @@ class ProxNet(nn.Module):
 
 @dataclasses.dataclass(frozen=True)
 class NetworkPrior:
-    """The learned prox as a `Prior` (lipjax.priors.base): hashable config + init/apply on a parameter pytree."""
+    """The learned prox as a prior (lipjax.priors.base): hashable config + init/apply on a parameter pytree."""
 
     stem_width: int = 16
     bottleneck_widths: tuple[int, int, int] = (8, 16, 24)

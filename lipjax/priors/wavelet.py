@@ -35,7 +35,6 @@ import math
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 _SQRT2 = math.sqrt(2.0)
 _SQRT3 = math.sqrt(3.0)
@@ -165,14 +164,14 @@ def cycle_offsets(shifts: int, levels: int) -> list[int]:
 
 @dataclasses.dataclass(frozen=True)
 class WaveletPrior:
-    """Wavelet soft-thresholding prox (the Prior protocol of lipjax.priors.base).
+    """Wavelet soft-thresholding prox (the prior interface of lipjax.priors.base).
 
     Attributes:
       levels: number of decomposition levels L (images are padded to multiples of 2^L).
       wavelet: "haar" or "db2".
       threshold_m: initial soft threshold tau in metres, returned by `init`.
       shifts: cycle-spinning shifts per axis (1 = none; shifts^2 transforms per call).
-      max_depth_m: the depth range of the scenes (metres; the Prior protocol's): the unit of a training loss.
+      max_depth_m: the depth range of the scenes (metres; part of the prior interface): the unit of a training loss.
     """
 
     levels: int = 4
@@ -199,13 +198,3 @@ class WaveletPrior:
         v = jnp.asarray(v)
         tau = jnp.maximum(jnp.asarray(params["threshold"], dtype=v.dtype), 0.0)
         return cycle_spun_shrink(v, tau, self.levels, self.wavelet, self.shifts)
-
-
-def transform_matrix(shape: tuple[int, int], levels: int, wavelet: str = "haar") -> np.ndarray:
-    """The (H W, H W) matrix of `dwt2` (rows: approximation first, then details finest level first), for tests
-    and analysis on tiny images."""
-    h, w = shape
-    eye = jnp.eye(h * w, dtype=jnp.float32).reshape(h * w, h, w)
-    approx, details = dwt2(eye, levels, wavelet)
-    parts = [approx.reshape(h * w, -1)] + [d.reshape(h * w, -1) for lvl in details for d in lvl]
-    return np.asarray(jnp.concatenate(parts, axis=1)).T

@@ -47,10 +47,10 @@ def check_frames(data: DataConfig) -> int:
     unreadable file (path relative to data.root and the reason), so that a bad file stops the run before
     training rather than at the step that first draws it."""
     from lipjax.data.folder import FolderDataset, read_depth
-    from lipjax.data.sources import _folder_root
+    from lipjax.data.sources import folder_split_root
 
     root = Path(data.root).resolve()
-    folders = {_folder_root(root, split)[0] for split in ("train", "val")}
+    folders = {folder_split_root(root, split)[0] for split in ("train", "val")}
     own_input = "input" in f"{data.train_sampler}|{data.val_sampler}"
     jobs = []
     for folder in sorted(folders):

@@ -126,6 +126,75 @@ def _signals_as_exit(save_first: bool):
             signal.signal(s, handler)
 
 
+def _resume(config: TrainConfig, manager: CheckpointManager, is_main: bool) -> tuple[TrainState, dict]:
+    """(state, checkpoint metadata): the latest checkpoint's, else a fresh state ({} metadata)."""
+    state = init_state(config, _initial_g_params(config))
+    meta: dict = {}
+    if manager.latest_step() is not None:
+        state, meta = manager.restore(state)
+        if meta.get("data_position") != int(state.step):
+            raise RuntimeError(f"checkpoint data position {meta.get('data_position')} != step {int(state.step)}")
+        if is_main:
+            print(f"[lipjax] resumed {config.name} from step {int(state.step)} in {manager.directory}")
+    return state, meta
+
+
+def _train_loader(config: TrainConfig, start: int, meta: dict, process_index: int, process_count: int) -> TrainLoader:
+    """This process's batches of every step from `start`, restoring the loader state a checkpoint saved."""
+    d = config.data
+    source = open_source(d, "train")
+    local = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
+                          process_index=process_index, process_count=process_count)
+    step_batches = StepBatches(local, config.total_steps, d.augment, d.crop, config.seed, config.model)
+    saved = meta.get("data_loader")
+    if saved is not None and saved["num_workers"] == d.num_workers and saved["next_step"] == start:
+        return TrainLoader(step_batches, saved["first_step"], d.num_workers, state=saved)
+    # no saved loader state (an older checkpoint) or another worker count: same batches from the step
+    return TrainLoader(step_batches, start, d.num_workers)
+
+
+class _Progress:
+    """The progress bar, metrics.jsonl (main process only) and the images/s rate of a run."""
+
+    def __init__(self, config: TrainConfig, workdir: pathlib.Path, start: int, end: int, show: bool, is_main: bool):
+        self.log = open(workdir / "metrics.jsonl", "a") if is_main else None
+        self.bar = tqdm(total=end, initial=start, desc=config.name, disable=not (show and is_main), dynamic_ncols=True)
+        self.t_last, self.images = time.perf_counter(), 0
+
+    def restart_clock(self) -> None:
+        """After the first step, which compiles (a minute or more here): leave it out of the images/s rate."""
+        self.t_last, self.images = time.perf_counter(), 0
+
+    def train_step(self, done: int, phase: str, metrics: dict, manager: CheckpointManager) -> None:
+        """Logs step `done`; TrainingDiverged on a non-finite loss."""
+        metrics = _to_float(metrics)
+        if not math.isfinite(metrics["loss"]):
+            raise TrainingDiverged(
+                f"non-finite loss {metrics['loss']} at step {done} ({phase}); stopped without saving. "
+                f"The last good checkpoint is step {manager.latest_step()} in {manager.directory}; "
+                f"lower the learning rate or check the data."
+            )
+        now = time.perf_counter()
+        rate = self.images / (now - self.t_last) if self.images else None  # None: only the compiling step ran
+        self.t_last, self.images = now, 0
+        self.bar.set_postfix(loss=f"{metrics['loss']:.4g}", img_s="-" if rate is None else f"{rate:.1f}",
+                             phase=phase[:3])
+        if self.log:
+            self.log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
+            self.log.flush()
+
+    def validation(self, done: int, vm: dict) -> None:
+        if self.log:
+            self.log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
+            self.log.flush()
+            self.bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
+
+    def close(self) -> None:
+        self.bar.close()
+        if self.log:
+            self.log.close()
+
+
 def train(
     config: TrainConfig,
     workdir: str | os.PathLike,
@@ -146,41 +215,20 @@ def train(
     workdir.mkdir(parents=True, exist_ok=True)
     (workdir / "config.txt").write_text(repr(config) + "\n")
     mesh = make_data_mesh() if mesh is None else mesh
-    replicated = NamedSharding(mesh, PartitionSpec())
     process_index = jax.process_index() if process_index is None else process_index
     process_count = jax.process_count() if process_count is None else process_count
     is_main = process_index == 0
 
     manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
-    state = init_state(config, _initial_g_params(config))
-    meta: dict = {}
-    if manager.latest_step() is not None:
-        state, meta = manager.restore(state)
-        if meta.get("data_position") != int(state.step):
-            raise RuntimeError(f"checkpoint data position {meta.get('data_position')} != step {int(state.step)}")
-        if is_main:
-            print(f"[lipjax] resumed {config.name} from step {int(state.step)} in {manager.directory}")
+    state, meta = _resume(config, manager, is_main)
     start = int(state.step)
     rng = jax.random.wrap_key_data(np.asarray(state.rng))
-    state = jax.device_put(state, replicated)
+    state = jax.device_put(state, NamedSharding(mesh, PartitionSpec()))  # replicated
     steps = make_steps(config)
     val = validation_batches(config) if config.eval_every else []
-    max_depth = config.model.max_depth_m
-
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
-    d = config.data
-    source = open_source(d, "train")
-    local = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
-                          process_index=process_index, process_count=process_count)
-    step_batches = StepBatches(local, config.total_steps, d.augment, d.crop, config.seed, config.model)
-    saved = meta.get("data_loader")
-    if saved is not None and saved["num_workers"] == d.num_workers and saved["next_step"] == start:
-        loader = TrainLoader(step_batches, saved["first_step"], d.num_workers, state=saved)
-    else:  # no saved loader state (an older checkpoint) or another worker count: same batches from the step
-        loader = TrainLoader(step_batches, start, d.num_workers)
-    log = open(workdir / "metrics.jsonl", "a") if is_main else None
-    bar = tqdm(total=end, initial=start, desc=config.name, disable=not (progress and is_main), dynamic_ncols=True)
-    t_last, images = time.perf_counter(), 0
+    loader = _train_loader(config, start, meta, process_index, process_count)
+    shown = _Progress(config, workdir, start, end, progress, is_main)
     step = start
     try:
         with _signals_as_exit(save_first=process_count == 1) as stop, loader:
@@ -188,47 +236,27 @@ def train(
                 batch = next(loader)
                 phase = config.phase(step)
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
-                images += config.batch_size
+                shown.images += config.batch_size
                 done = step + 1
                 if step == start:
-                    # The first step compiles (a minute or more here): leave it out of the images/s rate.
                     jax.block_until_ready(state)
-                    t_last, images = time.perf_counter(), 0
+                    shown.restart_clock()
                 if done % config.log_every == 0 or done == end:
-                    metrics = _to_float(metrics)
-                    if not math.isfinite(metrics["loss"]):
-                        raise TrainingDiverged(
-                            f"non-finite loss {metrics['loss']} at step {done} ({phase}); stopped without saving. "
-                            f"The last good checkpoint is step {manager.latest_step()} in {manager.directory}; "
-                            f"lower the learning rate or check the data."
-                        )
-                    now = time.perf_counter()
-                    rate = images / (now - t_last) if images else None  # None: only the compiling step ran
-                    t_last, images = now, 0
-                    bar.set_postfix(loss=f"{metrics['loss']:.4g}", img_s="-" if rate is None else f"{rate:.1f}",
-                                    phase=phase[:3])
-                    if log:
-                        log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
-                        log.flush()
+                    shown.train_step(done, phase, metrics, manager)
                 if done % config.checkpoint_every == 0 or done == end or stop.is_set():
                     manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
                                                "data_loader": loader.state()})
                 if stop.is_set() and done < end:
-                    bar.write(f"[lipjax] {signal.Signals(stop.signum).name}: saved step {done} in "
-                              f"{manager.directory}; stopping (run again to resume)")
+                    shown.bar.write(f"[lipjax] {signal.Signals(stop.signum).name}: saved step {done} in "
+                                    f"{manager.directory}; stopping (run again to resume)")
                     raise SystemExit(128 + stop.signum)
                 if val and (done % config.eval_every == 0 or done == end):
                     # every process evaluates (the parameters live on all of them); the main one logs
-                    vm = evaluate_params(config.model, state.g_params, val, max_depth)
-                    if log:
-                        log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
-                        log.flush()
-                        bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
-                bar.update(1)
+                    vm = evaluate_params(config.model, state.g_params, val, config.model.max_depth_m)
+                    shown.validation(done, vm)
+                shown.bar.update(1)
     finally:
-        bar.close()
-        if log:
-            log.close()
+        shown.close()
         manager.close()
     return state
 

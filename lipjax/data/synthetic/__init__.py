@@ -62,12 +62,18 @@ Per-primitive numpy calls are batched where the arithmetic allows it without cha
 (one call per material) and scene construction (Python) remain per object.
 
 Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`, `SceneInfo`,
-`LABELS` and the constants in `__all__`.
+`LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window of the camera)
+its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`), `render_scene` (the
+scene through a camera), `check_kind_split`, `check_size`.
 
 Modules, each importing only those before it: `constants`; `arrays`, `noise`, `colour` (numpy helpers, procedural
 noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (intersection kernels, primitives);
-`scene` (scene description, builder); `camera` (camera model); `culling`; `indoor`, `outdoor` (scene builders);
-`visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading); `dataset` (the public entry points).
+`scene` (scene description, builder); `camera` (camera model); `culling`;
+scene elements, each a builder with its parameter ranges in a frozen dataclass: `room_materials`, `furniture`,
+`indoor` (room shell, decals, camera, furniture placement, ceiling lights); `street` (the layout), `road`,
+`vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
+`scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
+`render_scene`); `dataset` (the public entry points: seeds, checks, `render`).
 """
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,
@@ -89,11 +95,17 @@ from lipjax.data.synthetic.constants import (
 from lipjax.data.synthetic.dataset import (
     SceneInfo,
     SyntheticDataset,
+    check_kind_split,
+    check_size,
+    frame_rngs,
     intrinsics_for,
     render,
     render_with_info,
     sample_id,
 )
+from lipjax.data.synthetic.renderer import render_scene
+from lipjax.data.synthetic.scene import Scene
+from lipjax.data.synthetic.scenes import build_scene
 
 __all__ = [
     "SYNTHETIC_KINDS",
@@ -111,10 +123,16 @@ __all__ = [
     "KITTI_CAMERA_HEIGHT_M",
     "RENDER_FAR_CLIP_M",
     "LABELS",
+    "Scene",
     "SceneInfo",
     "SyntheticDataset",
+    "build_scene",
+    "check_kind_split",
+    "check_size",
+    "frame_rngs",
     "intrinsics_for",
     "render",
+    "render_scene",
     "render_with_info",
     "sample_id",
 ]

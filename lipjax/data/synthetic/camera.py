@@ -12,7 +12,7 @@ import cv2
 import numpy as np
 
 from lipjax.data.synthetic.constants import _F32
-from lipjax.data.synthetic.scene import _Scene
+from lipjax.data.synthetic.scene import Scene
 
 
 def _camera_model(rng) -> dict:
@@ -54,7 +54,7 @@ def _vignette(H: int, W: int) -> np.ndarray:
     return (xx[None, :] ** 2 + yy[:, None] ** 2) * 0.5
 
 
-def _camera_image(lin: np.ndarray, scene: _Scene, H: int, W: int, noise_rng) -> np.ndarray:
+def _camera_image(lin: np.ndarray, scene: Scene, H: int, W: int, noise_rng) -> np.ndarray:
     """Linear radiance lin (3, H * W) float32 (overwritten) -> (H, W, 3) uint8: blur, exposure + white
     balance, vignetting, noise, tone curve, 8 bits. noise_rng: the frame's sensor-noise stream."""
     a = scene.blur

@@ -1,7 +1,7 @@
 """The public entry points: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`.
 
-Argument checks, per-frame seeds and sample ids live here; a frame is built by the `indoor` / `outdoor` scene
-builders and drawn by `renderer`.
+Argument checks (`check_kind_split`, `check_size`), per-frame random streams (`frame_rngs`) and sample ids live here;
+a frame's scene comes from `scenes.build_scene` and is drawn by `renderer.render_scene`.
 """
 from __future__ import annotations
 
@@ -23,9 +23,8 @@ from lipjax.data.synthetic.constants import (
     SPLITS,
     SYNTHETIC_KINDS,
 )
-from lipjax.data.synthetic.indoor import _indoor_scene
-from lipjax.data.synthetic.outdoor import _outdoor_scene
-from lipjax.data.synthetic.renderer import _render
+from lipjax.data.synthetic.renderer import render_scene
+from lipjax.data.synthetic.scenes import build_scene
 
 
 @dataclasses.dataclass(frozen=True)
@@ -45,7 +44,8 @@ class SceneInfo:
     labels: np.ndarray
 
 
-def _check_kind_split(kind: str, split: str) -> None:
+def check_kind_split(kind: str, split: str) -> None:
+    """ValueError unless kind is in SYNTHETIC_KINDS and split in SPLITS."""
     if kind not in SYNTHETIC_KINDS:
         raise ValueError(f"unknown synthetic kind {kind!r}; expected one of {SYNTHETIC_KINDS}")
     if split not in SPLITS:
@@ -60,8 +60,10 @@ def _check_index(index) -> int:
     return int(index)
 
 
-def _check_size(height, width) -> tuple[int, int]:
-    if not isinstance(height, (int, np.integer)) or not isinstance(width, (int, np.integer)) or height < 8 or width < 8:
+def check_size(height, width) -> tuple[int, int]:
+    """(height, width) as ints; ValueError unless both are ints >= 8 (pixels)."""
+    ints = isinstance(height, (int, np.integer)) and isinstance(width, (int, np.integer))
+    if not ints or height < 8 or width < 8:
         raise ValueError(f"height and width must be ints >= 8, got {height!r} x {width!r}")
     return int(height), int(width)
 
@@ -80,7 +82,7 @@ def intrinsics_for(kind: str, height: int = DEFAULT_HEIGHT, width: int = DEFAULT
     """
     if kind not in SYNTHETIC_KINDS:
         raise ValueError(f"unknown synthetic kind {kind!r}; expected one of {SYNTHETIC_KINDS}")
-    height, width = _check_size(height, width)
+    height, width = check_size(height, width)
     ref, (h0, w0) = (NYU_INTRINSICS, NYU_IMAGE_SIZE) if kind == "indoor" else (KITTI_INTRINSICS, KITTI_IMAGE_SIZE)
     if width * h0 <= height * w0:  # render narrower than the reference: crop columns
         ch, cw = float(h0), h0 * width / height
@@ -94,9 +96,14 @@ def sample_id(kind: str, split: str, index: int) -> str:
     return f"synthetic/{kind}/{split}/{index:06d}"
 
 
-def _seed(kind: str, split: str, index: int) -> int:
+def frame_rngs(kind: str, split: str, index: int) -> tuple[np.random.Generator, np.random.Generator]:
+    """(scene stream, sensor-noise stream) of frame `index` of (kind, split): two numpy Generators spawned from
+    sha256("lipjax/synthetic/v1/{kind}/{split}/{index}"), the same in every process."""
     digest = hashlib.sha256(f"lipjax/synthetic/v1/{kind}/{split}/{index}".encode("utf-8")).digest()
-    return int.from_bytes(digest[:16], "little")
+    seed = int.from_bytes(digest[:16], "little")
+    scene_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
+    noise_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
+    return scene_rng, noise_rng
 
 
 def render_with_info(
@@ -107,16 +114,14 @@ def render_with_info(
     Raises:
       ValueError: unknown kind / split, a negative or non-integer index, or a size below 8 pixels.
     """
-    _check_kind_split(kind, split)
+    check_kind_split(kind, split)
     index = _check_index(index)
-    height, width = _check_size(height, width)
-    seed = _seed(kind, split, index)
-    scene_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
-    noise_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
-    scene = _indoor_scene(scene_rng) if kind == "indoor" else _outdoor_scene(scene_rng)
+    height, width = check_size(height, width)
+    scene_rng, noise_rng = frame_rngs(kind, split, index)
+    scene = build_scene(kind, scene_rng)
     intr = intrinsics_for(kind, height, width)
     with np.errstate(all="ignore"):
-        rgb, depth, labels = _render(scene, height, width, intr, noise_rng)
+        rgb, depth, labels = render_scene(scene, height, width, intr, noise_rng)
     sample = Sample.from_depth(rgb, depth, intr, sample_id(kind, split, index))
     pose = np.eye(4)
     pose[:3, :3] = scene.cam_R
@@ -156,13 +161,13 @@ class SyntheticDataset:
 
     def __init__(self, kind: str, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT,
                  width: int = DEFAULT_WIDTH):
-        _check_kind_split(kind, split)
+        check_kind_split(kind, split)
         if size is None:
             size = DEFAULT_SIZES[split]
         if isinstance(size, (bool, np.bool_)) or not isinstance(size, (int, np.integer)) or size < 0:
             raise ValueError(f"size must be a non-negative int or None, got {size!r}")
         self.kind, self.split, self.size = kind, split, int(size)
-        self.height, self.width = _check_size(height, width)
+        self.height, self.width = check_size(height, width)
 
     def __len__(self) -> int:
         return self.size
@@ -203,7 +208,7 @@ class MixedSyntheticDataset:
 
     def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH):
         self.parts = tuple(SyntheticDataset(kind, split, None, height, width) for kind in SYNTHETIC_KINDS)
-        self.split, self.height, self.width = split, *_check_size(height, width)
+        self.split, self.height, self.width = split, *check_size(height, width)
         self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
 
     def __len__(self) -> int:

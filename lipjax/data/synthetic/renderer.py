@@ -1,6 +1,8 @@
 """The frame renderer: visibility, surfaces, lighting (shadows, gloss, haze, sky), then the camera model."""
 from __future__ import annotations
 
+import dataclasses
+
 import cv2
 import numpy as np
 
@@ -9,7 +11,7 @@ from lipjax.data.synthetic.arrays import _cols, _set_cols
 from lipjax.data.synthetic.camera import _camera_image
 from lipjax.data.synthetic.constants import _F32, _ROAD, _TERRAIN
 from lipjax.data.synthetic.primitives import _cache_hulls
-from lipjax.data.synthetic.scene import _Scene
+from lipjax.data.synthetic.scene import Light, Scene
 from lipjax.data.synthetic.shadows import _shadows
 from lipjax.data.synthetic.surfaces import _surfaces
 from lipjax.data.synthetic.visibility import _CameraRays, _visibility
@@ -24,17 +26,27 @@ def _by_material(prims: list) -> list:
     return sorted(prims, key=lambda p: first[id(p.mat)])
 
 
-def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    prims = _by_material(scene.prims)
-    _cache_hulls(prims)
-    rays = _CameraRays(scene, H, W, intr)
+@dataclasses.dataclass
+class _Surfaces:
+    """Per pixel (flat, N = H * W): what the camera ray hits and the surface there. Float32 unless noted."""
+
+    hit: np.ndarray  # bool, a primitive is hit
+    tz: np.ndarray  # z-depth of the hit, 0 where none
+    d: tuple  # ray directions (dx, dy, dz), world
+    p: tuple  # hit points (px, py, pz), world
+    n: tuple  # normals (nx, ny, nz), world
+    albedo: np.ndarray  # (3, N) linear
+    emit: np.ndarray
+    spec: np.ndarray
+    shin: np.ndarray
+    labels: np.ndarray  # int8, index into LABELS
+
+
+def _surfaces_of(prims: list, scene: Scene, rays: _CameraRays, zbuf, ids, intr: Intrinsics) -> _Surfaces:
+    """Normals, albedo, emission, gloss and labels of every pixel's hit."""
     ox, oy, oz = rays.origin
     dx, dy, dz = rays.d
-    r = [float(x) for x in scene.cam_R.ravel()]  # camera-to-world rotation, row-major (sky rays below)
-    zbuf, ids = _visibility(prims, scene, rays, intr)
-
-    # ---- surfaces: normals, albedo, emission, gloss per pixel
-    N = H * W
+    N = ids.size
     idf = ids.ravel()
     zf = zbuf.ravel()
     hit = idf >= 0
@@ -60,19 +72,39 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
         _set_cols(alb, sel, mat_out[0])
         for arr, val in zip((nx, ny, nz, emit, spec, shin, labels), (*normals, *mat_out[1:], hit_labels)):
             arr[sel] = val
-    terrain_x = getattr(scene, "terrain_x", None)
-    if terrain_x is not None:
-        labels[(labels == _ROAD) & (np.abs(px) > terrain_x)] = _TERRAIN
+    if scene.terrain_x is not None:
+        labels[(labels == _ROAD) & (np.abs(px) > scene.terrain_x)] = _TERRAIN
+    return _Surfaces(hit, tz, (dxf, dyf, dzf), (px, py, pz), (nx, ny, nz), alb, emit, spec, shin, labels)
 
-    # ---- lighting
+
+def _shadow_mask(scene: Scene, light: Light, recv, s: _Surfaces, intr: Intrinsics, H: int, W: int) -> np.ndarray:
+    """(N,) float32 in [0, 1]: how much of `light` reaches each pixel's surface.
+
+    Shadow rays for one pixel in each 2x2 block (the mask is then upsampled and softened): a quarter of the work,
+    at the cost of shadow edges resolved to 2 pixels."""
+    sub = (slice(0, None, 2), slice(0, None, 2))
+    lit = _shadows(scene, light, *(np.ascontiguousarray(a.reshape(H, W)[sub]) for a in (recv, *s.p)),
+                   *(np.ascontiguousarray(a.reshape(H, W)[sub]) for a in s.n),
+                   Intrinsics(intr.fx / 2, intr.fy / 2, intr.cx / 2, intr.cy / 2), (H + 1) // 2, (W + 1) // 2)
+    lit = np.repeat(np.repeat(lit, 2, axis=0), 2, axis=1)[:H, :W]
+    if light.shadow_blur > 0:  # a box blur: penumbrae, and it hides the stair steps
+        k = 2 * light.shadow_blur + 1
+        lit = cv2.blur(lit, (k, k), borderType=cv2.BORDER_REPLICATE)
+    return lit.ravel()
+
+
+def _shade(scene: Scene, s: _Surfaces, intr: Intrinsics, H: int, W: int) -> np.ndarray:
+    """(3, N) linear radiance of the hit surfaces: ambient, each light's Lambertian term (shadowed, with a point
+    light's falloff) and gloss, emission, then distance haze."""
+    nx, ny, nz = s.n
+    px, py, pz = s.p
     E = scene.ambient * (1.0 + scene.ambient_up * ny)  # (3, N)
-    glossy = np.flatnonzero(spec > 0)
+    glossy = np.flatnonzero(s.spec > 0)
     spec_rgb = np.zeros((3, glossy.size), _F32)
     if glossy.size:
-        vx, vy, vz = -dxf[glossy], -dyf[glossy], -dzf[glossy]
+        vx, vy, vz = (-a[glossy] for a in s.d)
         vn = 1.0 / np.sqrt(vx * vx + vy * vy + vz * vz)
         vx, vy, vz = vx * vn, vy * vn, vz * vn
-    nx2, ny2, nz2 = nx.reshape(H, W), ny.reshape(H, W), nz.reshape(H, W)
     for light in scene.lights:
         if light.direction is not None:
             lx, ly, lz = (float(c) for c in light.direction)
@@ -85,19 +117,8 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
             lx, ly, lz = lx * il, ly * il, lz * il
             ndl = nx * lx + ny * ly + nz * lz
             fall = 1.0 / (1.0 + d2 * (1.0 / (light.r0 * light.r0)))
-        recv = hit & (ndl > 0) & (emit <= 0)
-        # Shadow rays for one pixel in each 2x2 block (the mask is then upsampled and softened): a quarter of
-        # the work, at the cost of shadow edges resolved to 2 pixels.
-        sub = (slice(0, None, 2), slice(0, None, 2))
-        lit = _shadows(scene, light, *(np.ascontiguousarray(a.reshape(H, W)[sub]) for a in (recv, px, py, pz)),
-                       *(np.ascontiguousarray(a[sub]) for a in (nx2, ny2, nz2)),
-                       Intrinsics(intr.fx / 2, intr.fy / 2, intr.cx / 2, intr.cy / 2), (H + 1) // 2, (W + 1) // 2)
-        lit = np.repeat(np.repeat(lit, 2, axis=0), 2, axis=1)[:H, :W]
-        if light.shadow_blur > 0:  # a box blur: penumbrae, and it hides the stair steps
-            k = 2 * light.shadow_blur + 1
-            lit = cv2.blur(lit, (k, k), borderType=cv2.BORDER_REPLICATE)
-        shade = lit.ravel()
-        w = np.maximum(ndl, 0.0) * shade
+        recv = s.hit & (ndl > 0) & (s.emit <= 0)
+        w = np.maximum(ndl, 0.0) * _shadow_mask(scene, light, recv, s, intr, H, W)
         if fall is not None:
             w = w * fall
         E += light.color * w
@@ -109,31 +130,49 @@ def _render(scene: _Scene, H: int, W: int, intr: Intrinsics, noise_rng) -> tuple
             hx, hy, hz = gx + vx, gy + vy, gz + vz
             hn = 1.0 / np.sqrt(hx * hx + hy * hy + hz * hz + 1e-12)
             ndh = np.maximum((nx[glossy] * hx + ny[glossy] * hy + nz[glossy] * hz) * hn, 0.0)
-            sh = shin[glossy]
+            sh = s.shin[glossy]
             lobe = ndh / (sh - sh * ndh + ndh + 1e-6)  # Schlick's cheap stand-in for ndh ** shininess
-            spec_rgb += light.color * (spec[glossy] * lobe * w[glossy])
-    lin = alb * (E + emit)
+            spec_rgb += light.color * (s.spec[glossy] * lobe * w[glossy])
+    lin = s.albedo * (E + s.emit)
     if glossy.size:
         _set_cols(lin, glossy, _cols(lin, glossy) + spec_rgb)
     if scene.haze_dist > 0:  # aerial perspective (sky pixels are overwritten below)
-        f = np.exp(tz * (-1.0 / scene.haze_dist))
+        f = np.exp(s.tz * (-1.0 / scene.haze_dist))
         lin *= f
         lin += scene.haze_color * (1.0 - f)
-    if scene.sky is not None:
-        sky_px = ~hit
-        if sky_px.any():  # the sky is smooth: shade it at 1/4 resolution, upsample bilinearly
-            hs, ws = -(-H // 4), -(-W // 4)
-            xs = ((4.0 * np.arange(ws) + 1.5 - intr.cx) / intr.fx).astype(_F32)
-            ys = ((4.0 * np.arange(hs) + 1.5 - intr.cy) / intr.fy).astype(_F32)
-            sx = ((r[0] * xs)[None, :] + (r[1] * ys + r[2])[:, None]).ravel()
-            sy = ((r[3] * xs)[None, :] + (r[4] * ys + r[5])[:, None]).ravel()
-            sz = ((r[6] * xs)[None, :] + (r[7] * ys + r[8])[:, None]).ravel()
-            inv = 1.0 / np.sqrt(sx * sx + sy * sy + sz * sz)
-            small = scene.sky(sx * inv, sy * inv, sz * inv).reshape(3, hs, ws)
-            for c in range(3):
-                np.copyto(lin[c], cv2.resize(small[c], (W, H), interpolation=cv2.INTER_LINEAR).ravel(), where=sky_px)
+    return lin
 
+
+def _paint_sky(scene: Scene, lin: np.ndarray, sky_px: np.ndarray, intr: Intrinsics, H: int, W: int) -> None:
+    """Writes the sky's radiance into the (3, N) `lin` where `sky_px`: the sky is smooth, so it is shaded at 1/4
+    resolution and upsampled bilinearly."""
+    r = [float(x) for x in scene.cam_R.ravel()]  # camera-to-world rotation, row-major
+    hs, ws = -(-H // 4), -(-W // 4)
+    xs = ((4.0 * np.arange(ws) + 1.5 - intr.cx) / intr.fx).astype(_F32)
+    ys = ((4.0 * np.arange(hs) + 1.5 - intr.cy) / intr.fy).astype(_F32)
+    sx = ((r[0] * xs)[None, :] + (r[1] * ys + r[2])[:, None]).ravel()
+    sy = ((r[3] * xs)[None, :] + (r[4] * ys + r[5])[:, None]).ravel()
+    sz = ((r[6] * xs)[None, :] + (r[7] * ys + r[8])[:, None]).ravel()
+    inv = 1.0 / np.sqrt(sx * sx + sy * sy + sz * sz)
+    small = scene.sky(sx * inv, sy * inv, sz * inv).reshape(3, hs, ws)
+    for c in range(3):
+        np.copyto(lin[c], cv2.resize(small[c], (W, H), interpolation=cv2.INTER_LINEAR).ravel(), where=sky_px)
+
+
+def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics,
+                 noise_rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Draws `scene` through the camera `intr` at H x W pixels; `noise_rng` (a numpy Generator) draws the sensor
+    noise. Returns (rgb (H, W, 3) uint8, z-depth (H, W) float32 metres (0: nothing within scene.max_depth),
+    labels (H, W) int8 (index into LABELS, 0 = sky))."""
+    prims = _by_material(scene.prims)
+    _cache_hulls(prims)
+    rays = _CameraRays(scene, H, W, intr)
+    zbuf, ids = _visibility(prims, scene, rays, intr)
+    s = _surfaces_of(prims, scene, rays, zbuf, ids, intr)
+    lin = _shade(scene, s, intr, H, W)
+    if scene.sky is not None and (~s.hit).any():
+        _paint_sky(scene, lin, ~s.hit, intr, H, W)
     rgb = _camera_image(lin, scene, H, W, noise_rng)
-
-    depth = np.where(hit & (zf <= scene.max_depth), zf, 0.0).astype(_F32).reshape(H, W)
-    return rgb, depth, labels.reshape(H, W)
+    zf = zbuf.ravel()
+    depth = np.where(s.hit & (zf <= scene.max_depth), zf, 0.0).astype(_F32).reshape(H, W)
+    return rgb, depth, s.labels.reshape(H, W)

@@ -1,4 +1,4 @@
-"""The scene description (`_Scene`, `_Light`), the camera rotation and the primitive `_Builder`."""
+"""The scene description (`Scene`, `Light`), the camera rotation and the primitive `_Builder`."""
 from __future__ import annotations
 
 import dataclasses
@@ -13,7 +13,7 @@ from lipjax.data.synthetic.primitives import _Box, _Cyl, _Prim, _Spheres
 
 
 @dataclasses.dataclass
-class _Light:
+class Light:
     color: np.ndarray  # (3,) linear, intensity included
     direction: tuple | None = None  # unit vector towards a directional light
     position: tuple | None = None  # point light
@@ -22,7 +22,7 @@ class _Light:
 
 
 @dataclasses.dataclass
-class _Scene:
+class Scene:
     prims: list
     cam_pos: np.ndarray
     cam_R: np.ndarray  # camera-to-world rotation

@@ -8,7 +8,7 @@ from lipjax.data.synthetic.constants import _F32
 from lipjax.data.synthetic.culling import _rects
 from lipjax.data.synthetic.geometry import _shadow_t
 from lipjax.data.synthetic.primitives import _BOX_CORNERS
-from lipjax.data.synthetic.scene import _Light, _Scene
+from lipjax.data.synthetic.scene import Light, Scene
 
 
 def _f32_above(x: np.ndarray) -> np.ndarray:
@@ -23,100 +23,93 @@ def _f32_below(x: np.ndarray) -> np.ndarray:
     return np.where(y > x, np.nextafter(y, _F32(-np.inf)), y)
 
 
-def _shadows(scene: _Scene, light: _Light, recv, px, py, pz, nx, ny, nz, intr, H, W) -> np.ndarray:
-    """(H, W) float32: 0 where the light is blocked before reaching the surface point, else 1.
-
-    recv (H, W) bool: the points to test; px.. (H, W) their positions and normals; intr, H, W: the camera
-    of this (possibly subsampled) pixel grid.
-
-    A caster can only shadow points inside its shadow volume: the convex hull of its hull points and those
-    points pushed away from the light (to below the ground for the sun; by a homothety centred on a point
-    light, far enough to leave the scene). Only receivers inside the volume's screen rectangle are tested,
-    and then all (receiver, primitive) pairs of a kernel kind in one call."""
-    members: dict[int, list] = {}  # one caster per assembly (a car, a tree, a piece of furniture)
+def _casters(scene: Scene) -> tuple[list, np.ndarray] | None:
+    """(casters, their world AABB corners (C, 8, 3)): one caster per assembly (a car, a tree, a piece of furniture),
+    those wholly farther than scene.shadow_range from the camera left out (their shadow would be a few pixels);
+    None without any."""
+    members: dict[int, list] = {}
     for p in scene.prims:
         if p.cast and not p.infinite:
             members.setdefault(p.asm if p.asm >= 0 else -1 - id(p), []).append(p)
-    lit = np.ones((H, W), _F32)
-    litf = lit.ravel()  # a view
-    pxf, pyf, pzf, nxf, nyf, nzf = (a.ravel() for a in (px, py, pz, nx, ny, nz))
-    if not members or not recv.any():
-        return lit
+    if not members:
+        return None
     groups = list(members.values())
     flat = [p for g in groups for p in g]
     ph = np.stack([p.hull() for p in flat])  # (P, 8, 3)
     first = np.cumsum([0] + [len(g) for g in groups[:-1]])
     lo = np.minimum.reduceat(ph.min(1), first, axis=0)  # per assembly world AABB
     hi = np.maximum.reduceat(ph.max(1), first, axis=0)
-    # assemblies wholly far from the camera cast no shadow (it would be a few pixels)
     keep = np.maximum(lo - scene.cam_pos, scene.cam_pos - hi).max(1) < scene.shadow_range
     if not keep.any():
-        return lit
+        return None
     casters = [g for g, k in zip(groups, keep.tolist()) if k]
     lo, hi = lo[keep], hi[keep]
-    hulls = 0.5 * (lo + hi)[:, None, :] + _BOX_CORNERS[None] * (0.5 * (hi - lo))[:, None, :]
-    if light.direction is not None:
-        L = np.asarray(light.direction)
-        s = (hulls[..., 1].max(1) + 0.1) / max(L[1], 0.05)
-        far = hulls - s[:, None, None] * L
-        dl = tuple(_F32(c) for c in L)
-        # Light-space culling: a receiver can only be shadowed by a caster whose projection along L covers
-        # it, and which lies towards the light from it.
-        e1 = np.cross(L, [0.0, 0.0, 1.0] if abs(L[2]) < 0.9 else [1.0, 0.0, 0.0])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(L, e1)
-        frame = np.stack([e1, e2, L])  # (3, 3)
-        hl = hulls @ frame.T  # (P, 8, 3)
-        lo, hi = hl.min(1) - 1e-3, hl.max(1) + 1e-3
-        f = [float(x) for x in frame.ravel()]
-        qa = px * f[0] + py * f[1] + pz * f[2]
-        qb = px * f[3] + py * f[4] + pz * f[5]
-        qc = px * f[6] + py * f[7] + pz * f[8]
-    else:
-        Lp = np.asarray(light.position)
-        dist = np.linalg.norm(hulls - Lp, axis=-1).min(1)
-        lam = 1.0 + scene.extent / np.maximum(dist, 1e-3)
-        far = Lp + lam[:, None, None] * (hulls - Lp)
-        inside = np.all((hulls.min(1) < Lp) & (hulls.max(1) > Lp), axis=1)
-        # Cone culling: the caster's bounding sphere seen from the light subtends a cone; receivers outside
-        # it, or nearer to the light than the caster, cannot be shadowed by it.
-        centre = hulls.mean(1)
-        rad = np.linalg.norm(hulls - centre[:, None], axis=-1).max(1)
-        cd = np.linalg.norm(centre - Lp, axis=-1)
-        axis = (centre - Lp) / np.maximum(cd, 1e-9)[:, None]
-        cos_half = np.sqrt(np.clip(1.0 - (rad / np.maximum(cd, 1e-9)) ** 2, 0.0, 1.0)) - 1e-4
-        ux, uy, uz = px - float(Lp[0]), py - float(Lp[1]), pz - float(Lp[2])
-        ud = np.sqrt(ux * ux + uy * uy + uz * uz)
-        iu = 1.0 / np.maximum(ud, 1e-9)
-        ux, uy, uz = ux * iu, uy * iu, uz * iu
-    rects = _rects(np.concatenate([hulls, far], axis=1), scene.cam_pos, scene.cam_R.T, intr, H, W)
+    return casters, 0.5 * (lo + hi)[:, None, :] + _BOX_CORNERS[None] * (0.5 * (hi - lo))[:, None, :]
+
+
+def _sun_culling(light: Light, hulls: np.ndarray, recv, px, py, pz):
+    """(far ends of the shadow volumes (C, 8, 3), mask(k, sl)) for a directional light: a receiver can only be
+    shadowed by a caster whose projection along the light covers it, and which lies towards the light from it."""
+    L = np.asarray(light.direction)
+    s = (hulls[..., 1].max(1) + 0.1) / max(L[1], 0.05)
+    far = hulls - s[:, None, None] * L  # pushed to below the ground
+    e1 = np.cross(L, [0.0, 0.0, 1.0] if abs(L[2]) < 0.9 else [1.0, 0.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(L, e1)
+    frame = np.stack([e1, e2, L])  # (3, 3)
+    hl = hulls @ frame.T  # (P, 8, 3)
+    lo, hi = hl.min(1) - 1e-3, hl.max(1) + 1e-3
+    f = [float(x) for x in frame.ravel()]
+    qa = px * f[0] + py * f[1] + pz * f[2]
+    qb = px * f[3] + py * f[4] + pz * f[5]
+    qc = px * f[6] + py * f[7] + pz * f[8]
     # The culling bounds as float32 numbers that give the same comparisons against float32 arrays (a float64
     # bound would make numpy cast the arrays, twice as slow).
-    if light.direction is not None:
-        lo, hi_c, hi = _f32_above(lo), _f32_above(hi[:, 2]), _f32_below(hi)
-    else:
-        cos_half, near = _f32_above(cos_half), _f32_below(cd - rad)
-    tests = []  # (caster, flat indices of its candidate receivers)
-    for k, p in enumerate(casters):
-        r0, r1, c0, c1 = rects[k]
-        if r0 >= r1 or c0 >= c1:
-            continue
-        sl = (slice(r0, r1), slice(c0, c1))
-        if light.direction is not None:
-            a, b_, c = qa[sl], qb[sl], qc[sl]
-            m = recv[sl] & (a >= lo[k, 0]) & (a <= hi[k, 0]) & (b_ >= lo[k, 1]) & (b_ <= hi[k, 1]) & (c < hi_c[k])
-        elif inside[k]:
-            continue
-        elif cd[k] > rad[k]:
+    lo, hi_c, hi = _f32_above(lo), _f32_above(hi[:, 2]), _f32_below(hi)
+
+    def mask(k: int, sl: tuple) -> np.ndarray:
+        a, b_, c = qa[sl], qb[sl], qc[sl]
+        return recv[sl] & (a >= lo[k, 0]) & (a <= hi[k, 0]) & (b_ >= lo[k, 1]) & (b_ <= hi[k, 1]) & (c < hi_c[k])
+
+    return far, mask
+
+
+def _point_culling(scene: Scene, light: Light, hulls: np.ndarray, recv, px, py, pz):
+    """(far ends of the shadow volumes (C, 8, 3), mask(k, sl) or None to skip caster k) for a point light: the
+    caster's bounding sphere seen from the light subtends a cone; receivers outside it, or nearer to the light
+    than the caster, cannot be shadowed by it. A caster around the light casts no shadow."""
+    Lp = np.asarray(light.position)
+    dist = np.linalg.norm(hulls - Lp, axis=-1).min(1)
+    lam = 1.0 + scene.extent / np.maximum(dist, 1e-3)
+    far = Lp + lam[:, None, None] * (hulls - Lp)  # a homothety centred on the light, out of the scene
+    inside = np.all((hulls.min(1) < Lp) & (hulls.max(1) > Lp), axis=1)
+    centre = hulls.mean(1)
+    rad = np.linalg.norm(hulls - centre[:, None], axis=-1).max(1)
+    cd = np.linalg.norm(centre - Lp, axis=-1)
+    axis = (centre - Lp) / np.maximum(cd, 1e-9)[:, None]
+    cos_half = np.sqrt(np.clip(1.0 - (rad / np.maximum(cd, 1e-9)) ** 2, 0.0, 1.0)) - 1e-4
+    ux, uy, uz = px - float(Lp[0]), py - float(Lp[1]), pz - float(Lp[2])
+    ud = np.sqrt(ux * ux + uy * uy + uz * uz)
+    iu = 1.0 / np.maximum(ud, 1e-9)
+    ux, uy, uz = ux * iu, uy * iu, uz * iu
+    cos_half32, near = _f32_above(cos_half), _f32_below(cd - rad)  # float32 bounds, as in _sun_culling
+
+    def mask(k: int, sl: tuple) -> np.ndarray | None:
+        if inside[k]:
+            return None
+        if cd[k] > rad[k]:
             ax_, ay_, az_ = (float(x) for x in axis[k])
-            m = recv[sl] & (ux[sl] * ax_ + uy[sl] * ay_ + uz[sl] * az_ >= cos_half[k]) & (ud[sl] > near[k])
-        else:
-            m = recv[sl]
-        rr, cc = np.nonzero(m)
-        if rr.size:
-            tests.append((p, (rr + r0) * W + (cc + c0)))
-    if not tests:
-        return lit
+            return recv[sl] & (ux[sl] * ax_ + uy[sl] * ay_ + uz[sl] * az_ >= cos_half32[k]) & (ud[sl] > near[k])
+        return recv[sl]
+
+    return far, mask
+
+
+def _blocked(scene: Scene, light: Light, tests: list, points: tuple, normals: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """(flat receiver indices, whether each is blocked) for the (caster, flat receiver indices) pairs in `tests`;
+    points and normals: the flat (x, y, z) arrays of the receivers' positions and normals."""
+    pxf, pyf, pzf = points
+    nxf, nyf, nzf = normals
     # Shadow-ray origins: the receivers, pushed off their surface along the normal.
     fi = np.concatenate([f for _, f in tests])
     qx, qy, qz = pxf[fi], pyf[fi], pzf[fi]
@@ -138,10 +131,49 @@ def _shadows(scene: _Scene, light: _Light, recv, px, py, pz, nx, ny, nz, intr, H
         P = np.repeat(np.array(params, np.float64).astype(_F32).T, n, axis=1)
         ox, oy, oz = qx[idx], qy[idx], qz[idx]
         if light.direction is not None:
+            dl = tuple(_F32(c) for c in np.asarray(light.direction))
             hit = _shadow_t(kind, P, ox, oy, oz, *dl) < np.inf
         else:
             Lp0, Lp1, Lp2 = (float(c) for c in light.position)
             hit = _shadow_t(kind, P, ox, oy, oz, Lp0 - ox, Lp1 - oy, Lp2 - oz) < 1.0
         blocked[idx[hit]] = True
-    litf[fi[blocked]] = 0.0
+    return fi, blocked
+
+
+def _shadows(scene: Scene, light: Light, recv, px, py, pz, nx, ny, nz, intr, H, W) -> np.ndarray:
+    """(H, W) float32: 0 where the light is blocked before reaching the surface point, else 1.
+
+    recv (H, W) bool: the points to test; px.. (H, W) their positions and normals; intr, H, W: the camera
+    of this (possibly subsampled) pixel grid.
+
+    A caster can only shadow points inside its shadow volume: the convex hull of its hull points and those
+    points pushed away from the light (to below the ground for the sun; by a homothety centred on a point
+    light, far enough to leave the scene). Only receivers inside the volume's screen rectangle are tested,
+    and then all (receiver, primitive) pairs of a kernel kind in one call."""
+    lit = np.ones((H, W), _F32)
+    found = _casters(scene) if recv.any() else None
+    if found is None:
+        return lit
+    casters, hulls = found
+    if light.direction is not None:
+        far, mask = _sun_culling(light, hulls, recv, px, py, pz)
+    else:
+        far, mask = _point_culling(scene, light, hulls, recv, px, py, pz)
+    rects = _rects(np.concatenate([hulls, far], axis=1), scene.cam_pos, scene.cam_R.T, intr, H, W)
+    tests = []  # (caster, flat indices of its candidate receivers)
+    for k, p in enumerate(casters):
+        r0, r1, c0, c1 = rects[k]
+        if r0 >= r1 or c0 >= c1:
+            continue
+        m = mask(k, (slice(r0, r1), slice(c0, c1)))
+        if m is None:
+            continue
+        rr, cc = np.nonzero(m)
+        if rr.size:
+            tests.append((p, (rr + r0) * W + (cc + c0)))
+    if not tests:
+        return lit
+    fi, blocked = _blocked(scene, light, tests, tuple(a.ravel() for a in (px, py, pz)),
+                           tuple(a.ravel() for a in (nx, ny, nz)))
+    lit.ravel()[fi[blocked]] = 0.0  # ravel of a contiguous array: a view
     return lit

@@ -11,7 +11,7 @@ from lipjax.data.synthetic.arrays import _cols
 from lipjax.data.synthetic.constants import _F32
 from lipjax.data.synthetic.culling import _rect_pixels, _rects
 from lipjax.data.synthetic.geometry import _EPS, _camera_t
-from lipjax.data.synthetic.scene import _Scene
+from lipjax.data.synthetic.scene import Scene
 
 
 class _CameraRays:
@@ -21,7 +21,7 @@ class _CameraRays:
     component is 1, so the ray parameter t of a hit is its z-depth. The inverse directions (axis-aligned
     boxes) are computed on first use."""
 
-    def __init__(self, scene: _Scene, H: int, W: int, intr: Intrinsics):
+    def __init__(self, scene: Scene, H: int, W: int, intr: Intrinsics):
         self.origin = tuple(float(x) for x in scene.cam_pos)
         r = [float(x) for x in scene.cam_R.ravel()]
         xn = ((np.arange(W, dtype=np.float64) - intr.cx) / intr.fx).astype(_F32)
@@ -53,7 +53,7 @@ class _CameraRays:
 _BATCH_PIXELS = 1024
 
 
-def _visibility(prims: list, scene: _Scene, rays: _CameraRays, intr: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
+def _visibility(prims: list, scene: Scene, rays: _CameraRays, intr: Intrinsics) -> tuple[np.ndarray, np.ndarray]:
     """Nearest hit per pixel: z-depth (H, W) float32 (inf: none) and index into `prims` (H, W) int16 (-1).
 
     Parts (convex pieces of the primitives) are merged into the depth buffer front to back, by the nearest
