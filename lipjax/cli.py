@@ -31,9 +31,10 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
               X.npy        float32 metres.
               X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
                            (npy input); values above 65535 are clipped, with a warning.
-              X.color.png  8-bit colour picture (lipjax.viz.colorize_depth, turbo) over the fixed range
-                           --color-range (default 0 m to the model's max depth: 10 m indoor, 85 m outdoor);
-                           black = no depth.
+              X.color.png  8-bit colour picture (lipjax.viz.colorize_depth, turbo) over --color-range; by
+                           default 0 m to the model's max depth (10 m indoor, 85 m outdoor), or to the output's
+                           99th percentile when that is beyond the model's range or under a quarter of it
+                           (lipjax.viz.fitting_range; with folders, the first frame's); black = no depth.
             With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
             (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
             Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
@@ -45,6 +46,10 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
             10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
   --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
             in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
+  --fill-all  write depth at every pixel. Without it, pixels that no sample supports are 0 (no depth) in --out
+            and --ply: those more than one sample spacing s above the highest sample of their column (sky, above
+            the top LiDAR beam), and those farther than 3 s from every sample (s = sqrt(area of the samples'
+            bounding box / their number), pixels; lipjax.uncertainty.support_mask). --uncertainty keeps every pixel.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
 in training (lipjax.resolution: 200 points on 640x480 run at about half size; a 64-beam scan at full size); a new
@@ -123,7 +128,8 @@ def _cmd_complete(args) -> int:
     from lipjax.inference import LARGE_FRAME_PIXELS, complete_frame, frame_size, get_completer
     from lipjax.inputs import scene_reason
     from lipjax.pointcloud import backproject_rgbd, write_ply
-    from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
+    from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported, write_uncertainty
+    from lipjax.viz import fitting_range
 
     if (args.depth is None) == (args.lidar is None):
         raise CLIError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
@@ -169,6 +175,8 @@ def _cmd_complete(args) -> int:
               "metres, never scaled (--depth-scale applies to .png depth, in and out)")
 
     completer = None  # loaded after the first frame is read: input errors come before the slow model load
+    color_range = tuple(args.color_range) if args.color_range else None  # else fitted to the first frame
+    unsupported = pixels = 0  # pixels set to 0 for want of support, and all pixels, over all frames
     progress = jobs
     if len(jobs) > 1 and not args.quiet:
         from tqdm import tqdm
@@ -186,7 +194,6 @@ def _cmd_complete(args) -> int:
                 scene, why = scene_reason(sparse)
                 print(f"model: {completer.name}, the default for {scene} input ({why}); "
                       "choose another with --model", file=sys.stderr)
-            color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
             h, w = frame_size(completer, sparse, args.max_side)
             if args.max_side is None and h * w > LARGE_FRAME_PIXELS:
                 _warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) runs "
@@ -200,14 +207,26 @@ def _cmd_complete(args) -> int:
                                   args.max_uncertainty or 0.1 * _model_max_depth(completer))
             if args.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, args.max_uncertainty)
+        if not args.fill_all:
+            masked = mask_unsupported(dense, sparse)
+            unsupported, pixels = unsupported + int(((masked == 0) & (dense > 0)).sum()), pixels + dense.size
+            dense = masked
+        if color_range is None:
+            color_range = fitting_range(dense, _model_max_depth(completer))
         write_depth(out_file, dense, fmt, out_scale, color_range)
         if ply_file is not None:
             ply_file.parent.mkdir(parents=True, exist_ok=True)
             write_ply(ply_file, *backproject_rgbd(dense, rgb, intrinsics))
-    if len(jobs) == 1 and not args.quiet:
-        print(f"wrote {jobs[0][2]}" + (f" and {jobs[0][3]}" if jobs[0][3] else ""), file=sys.stderr)
-    elif not args.quiet:
-        print(f"wrote {len(jobs)} frame(s) to {out}", file=sys.stderr)
+    if not args.quiet:
+        if len(jobs) == 1:
+            wrote = f"{jobs[0][2]}" + (f" and {jobs[0][3]}" if jobs[0][3] else "")
+        else:
+            wrote = f"{len(jobs)} frame(s) to {out}"
+        notes = [f"{100 * unsupported / pixels:.1f} % of the pixels without support set to 0 (--fill-all keeps "
+                 "them)"] if unsupported else []
+        if fmt == "color.png" and not args.color_range:
+            notes.append(f"colours 0-{color_range[1]:.3g} m")
+        print(f"wrote {wrote}" + (f": {'; '.join(notes)}" if notes else ""), file=sys.stderr)
     return 0
 
 
@@ -464,6 +483,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, default=None, metavar="M",
                    help="depth 0 (none) where the expected error is above M metres, in --out and --ply")
+    c.add_argument("--fill-all", action="store_true",
+                   help="write depth at every pixel, also where no sample supports it (default: 0 there)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
     c.set_defaults(func=_cmd_complete)
     _add_project_parser(sub)

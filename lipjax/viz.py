@@ -6,7 +6,8 @@ colour tables come from `matplotlib.colormaps`, figures are drawn on an Agg canv
 Conventions, fixed so that pictures of different frames and methods compare:
   - `colorize_depth(depth_m, min_m=0, max_m=10, cmap="turbo")`: depth is clipped to [min_m, max_m] metres and
     mapped linearly onto the colour map, near = low end (dark blue for turbo), far = high end (dark red).
-    The range never adapts to the image: pass min_m / max_m (e.g. 0-10 m indoors, 0-80 m outdoors).
+    The range never adapts to the image: pass min_m / max_m (e.g. 0-10 m indoors, 0-80 m outdoors), or
+    `fitting_range(depth_m, max_m)`, the model's range unless the data do not fit it.
     Invalid pixels (depth <= 0, NaN, inf) are black.
   - `error_map(pred, gt, valid, max_error_m=1)`: |pred - gt| in metres on "jet", dark blue (0 m) to dark red
     (>= max_error_m), as the paper's error maps ("the value of the error increases from dark blue to dark red").
@@ -61,6 +62,23 @@ def colorize_depth(depth_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
         raise ValueError(f"depth must be (H, W), got shape {depth.shape}")
     valid = np.isfinite(depth) & (depth > 0)
     return _apply(depth, min_m, max_m, valid, cmap)
+
+
+FIT_PERCENTILE = 99.0
+"""The depth percentile (of the valid pixels) that `fitting_range` fits the colour range to."""
+
+
+def fitting_range(depth_m: np.ndarray, max_m: float) -> tuple[float, float]:
+    """A colour range (0, top) metres for `depth_m` (any shape; <= 0, NaN and inf are no depth): (0, max_m),
+    e.g. the model's range, when its FIT_PERCENTILE-th percentile p of the valid depths lies in [max_m / 4, max_m];
+    else (0, p), so that a picture neither saturates (p > max_m) nor uses under a quarter of the colours.
+    (0, max_m) when no pixel has depth."""
+    depth = np.asarray(depth_m, np.float64)
+    valid = depth[np.isfinite(depth) & (depth > 0)]
+    if valid.size == 0:
+        return 0.0, float(max_m)
+    p = float(np.percentile(valid, FIT_PERCENTILE))
+    return (0.0, float(max_m)) if max_m / 4 <= p <= max_m else (0.0, p)
 
 
 def colorize_sparse(sparse_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,

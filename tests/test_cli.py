@@ -15,6 +15,7 @@ import lipjax
 from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
+from lipjax.uncertainty import mask_unsupported
 
 H, W = 24, 32
 SCALE = 256.0
@@ -211,7 +212,8 @@ def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_
                    "--ply", str(tmp_path / "a.ply"), "-q"])
     assert rc == 0
     sparse, _ = project_sweep(tmp_path / "sweep.npy", calib, (40, 120))
-    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), model[1](rgb, sparse), rtol=1e-6)
+    expected = mask_unsupported(model[1](rgb, sparse), sparse)  # 0 above the scan: lipjax complete's default
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-6)
     np.save(tmp_path / "sparse.npy", sparse)
     for ply, intrinsics in (("b.ply", ["--intrinsics", str(FX), str(FY), str(CX), str(CY)]),
                             ("c.ply", ["--intrinsics-file", str(calib)])):
@@ -238,6 +240,26 @@ def test_the_default_model_is_named_with_its_reason_and_depth_scale_on_npy_warns
                                        "scaled (--depth-scale applies to .png depth, in and out)\n")
     assert cli.main(args[:-1] + [str(tmp_path / "out.png"), "-q", "--depth-scale", "256"]) == 0  # the PNG's scale
     assert capsys.readouterr().err == ""
+
+
+def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsys):
+    """The tiny model's range is 10 m; samples at 20-40 m would make a solid-red picture, so the colours span
+    0 .. the output's 99th percentile, and the summary line says so; --color-range still wins."""
+    rgb, sparse = _frame(seed=4)
+    rgb_path, npy = _write_frame(tmp_path, rgb, sparse * 8, depth_name="far.npy")
+    out = tmp_path / "o.color.png"
+    args = ["complete", "--rgb", rgb_path, "--depth", npy, "--model", model[0], "--out", str(out)]
+    assert cli.main(args) == 0
+    with pytest.warns(UserWarning, match="beyond the 10 m range"):
+        dense = mask_unsupported(model[1](rgb, sparse * 8), sparse * 8)
+    top = np.percentile(dense[dense > 0], 99)
+    assert 20 < top < 40 and model[1].config.max_depth_m == 10
+    np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, top))
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("lipjax: warning: sparse depth beyond the 10 m range of the indoor model")
+    assert err[1:] == [f"wrote {out}: colours 0-{top:.3g} m"]
+    assert cli.main(args + ["--color-range", "0", "10", "-q"]) == 0
+    np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, 10))
 
 
 def test_usage_error_returns_2_with_one_line(capsys):

@@ -73,3 +73,14 @@ def test_comparison_row_and_figure(tmp_path):
                    colorbars=[("depth [m]", 0, 10, "turbo"), ("error [m]", 0, 0.5, "jet")])
     fig = cv2.imread(str(tmp_path / "fig.png"))
     assert fig is not None and fig.shape[1] > fig.shape[0]
+
+
+def test_fitting_range_is_the_models_unless_the_data_do_not_fit():
+    rng = np.random.default_rng(0)
+    indoor = rng.uniform(1, 8, (20, 30))
+    assert viz.fitting_range(indoor, 10.0) == (0.0, 10.0)                     # fits: the fixed range
+    street = np.concatenate([rng.uniform(5, 60, 990), np.full(10, 500.0), [0.0, np.nan, np.inf]])
+    assert viz.fitting_range(street, 10.0) == (0.0, pytest.approx(np.percentile(street[:1000], 99)))
+    assert viz.fitting_range(street, 10.0)[1] < 500                         # the 1 % outliers do not set it
+    assert viz.fitting_range(indoor, 85.0) == (0.0, pytest.approx(np.percentile(indoor, 99)))  # under 85 / 4
+    assert viz.fitting_range(np.zeros((4, 4)), 10.0) == (0.0, 10.0)
