@@ -230,48 +230,36 @@ def _cmd_complete(args) -> int:
     return 0
 
 
-def _needs_intrinsics(sampler) -> bool:
-    """Whether a sampler (lipjax.data.sampling) uses the camera intrinsics: the LiDAR simulation does."""
-    from lipjax.data.sampling import LidarSampler
-
-    inner = getattr(sampler, "samplers", None) or (getattr(sampler, "sampler", sampler),)
-    return any(isinstance(s, LidarSampler) or (s is not sampler and _needs_intrinsics(s)) for s in inner)
-
-
-def _data_frames(args, sampler, protocol):
-    """(the frames of --data: the synthetic split or FOLDER, no protocol applied yet; the protocol whose depth
-    range applies, or None)."""
+def _data_frames(args, protocol):
+    """(the frames of --data: the synthetic split or FOLDER, no protocol applied yet; their sampler; the sampler's
+    spec; the data in words; the protocol whose depth range applies, or None)."""
     from lipjax.data import protocols
-    from lipjax.data.sample import Intrinsics
+    from lipjax.evaluate import DEFAULT_SAMPLER, open_folder
 
     if args.data in ("synthetic-indoor", "synthetic-outdoor"):
+        from lipjax.data.sampling import sampler_from_spec
         from lipjax.data.synthetic import SyntheticDataset
 
-        kind = args.data.split("-")[1]
+        kind, spec = args.data.split("-")[1], args.sampler or DEFAULT_SAMPLER
         height, width = args.size or (None, None)
         size_kw = {"height": height, "width": width} if args.size else {}
-        return (SyntheticDataset(kind, args.split or "test", **size_kw),
+        return (SyntheticDataset(kind, args.split or "test", **size_kw), sampler_from_spec(spec), spec, args.data,
                 protocol or protocols.get_protocol(f"synthetic_{kind}"))
-    from lipjax.data.folder import FolderDataset
-
     root = Path(args.data)
     if not root.is_dir():
         raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
-    intrinsics = _intrinsics_from_args(args)
-    if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
-        if _needs_intrinsics(sampler):
-            raise CLIError(f"--sampler {args.sampler} simulates a LiDAR and needs the camera intrinsics of the "
-                           f"frames in {root}: pass --intrinsics fx fy cx cy or --intrinsics-file F, or write "
-                           f"{root / 'intrinsics.txt'} (fx fy cx cy)")
-        intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # unused: neither this sampler nor the metrics need them
-    return FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics), protocol
+    if args.split == "test":
+        raise CLIError(f"--split test: a folder has train and val frames (--split train|val), or leave --split out "
+                       f"to score every frame of {root}")
+    frames, sampler, spec, which = open_folder(root, args.split, sampler=args.sampler, depth_scale=args.depth_scale,
+                                               intrinsics=_intrinsics_from_args(args))
+    return frames, sampler, spec, f"{args.data}, {which}", protocol
 
 
 def _cmd_evaluate(args) -> int:
     from lipjax.data import protocols
-    from lipjax.data.sampling import sampler_from_spec
-    from lipjax.data.sources import NO_PROTOCOL
-    from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, open_eval_source, save_json
+    from lipjax.data.sources import NO_PROTOCOL, OWN_INPUT
+    from lipjax.evaluate import DEFAULT_COLUMNS, DEFAULT_SAMPLER, evaluate, markdown_table, open_eval_source, save_json
     from lipjax.inference import get_completer
 
     if args.source is None and (args.root is not None or args.raw_root is not None):
@@ -293,8 +281,8 @@ def _cmd_evaluate(args) -> int:
         if args.source == "rendered" and args.split is not None:
             raise CLIError("--split: --source rendered evaluates the frames in --root (their split is the render's); "
                            "drop --split")
-        split = args.split or "val"
-        source, range_from = open_eval_source(args.source, args.root, split, sampler=args.sampler,
+        split, spec = args.split or "val", args.sampler or DEFAULT_SAMPLER
+        source, range_from = open_eval_source(args.source, args.root, split, sampler=spec,
                                               protocol=args.protocol, raw_root=args.raw_root,
                                               depth_scale=args.depth_scale, kind=args.kind)
         dataset, sampler = source.dataset, source.sampler  # protocol applied
@@ -309,11 +297,9 @@ def _cmd_evaluate(args) -> int:
             data_name = f"{args.source}{kind} {split}" + (f" ({args.root})" if args.root else "")
     else:
         protocol = protocols.get_protocol(args.protocol) if args.protocol not in (None, NO_PROTOCOL) else None
-        sampler = sampler_from_spec(args.sampler)
-        dataset, range_from = _data_frames(args, sampler, protocol)
+        dataset, sampler, spec, data_name, range_from = _data_frames(args, protocol)
         if protocol is not None:
             dataset = protocols.ProtocolView(dataset, protocol)
-        data_name = args.data
     min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
     max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
     if max_depth is None:
@@ -321,13 +307,14 @@ def _cmd_evaluate(args) -> int:
                        "or --protocol NAME")
     columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
     results = {}
-    for model in args.model or [None]:
-        completer = get_completer(model, args.iterations)
+    for model in args.model or [None]:  # the default model: the one the first frame's input suggests
+        completer = get_completer(model, args.iterations, sparse=None if model else sampler(dataset[0], args.seed))
         label = model if model is not None else ("untrained" if completer.name == "random" else completer.name)
         results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
                                   limit=args.limit, progress=not args.quiet, seed=args.seed)
     n = next(iter(results.values())).num_images
-    print(f"data: {data_name} ({n} frames), sampler: {args.sampler}, depth range: ({min_depth:g}, {max_depth:g}] m")
+    own = " (the data's own sparse maps)" if spec.split(":")[0] == OWN_INPUT else ""
+    print(f"data: {data_name} ({n} frames), sampler: {spec}{own}, depth range: ({min_depth:g}, {max_depth:g}] m")
     print()
     print(markdown_table(results, columns=columns))
     if args.json:
@@ -387,17 +374,21 @@ def _cmd_data_render(args) -> int:
 
 def _cmd_train(args) -> int:
     from lipjax import model_io
-    from lipjax.train.folder import folder_config
+    from lipjax.train.folder import default_init, folder_config
     from lipjax.train.run import run
 
-    model = model_io.load(args.init)[0]
     data = {"root": args.data, "depth_scale": args.depth_scale, "num_workers": args.workers,
             **({"crop": tuple(args.crop)} if args.crop else {}),
             **({"train_sampler": args.sampler} if args.sampler else {})}
-    config = folder_config(model, args.init, **data)
+    init = args.init
+    if init is None:
+        init, scene, why = default_init(**data)
+        if not args.quiet:
+            print(f"init: {init}, the default for {scene} input ({why}); choose another with --init", file=sys.stderr)
+    name = Path(args.out).name
+    config = folder_config(model_io.load(init)[0], init, name=name, **data)
     config = dataclasses.replace(config, batch_size=args.batch_size, **({"g_steps": args.steps} if args.steps else {}))
-    run(config, args.workdir or f"runs/train-{Path(args.data).resolve().name}", export=args.out,
-        progress=not args.quiet)
+    run(config, args.workdir or f"runs/train-{name}", export=args.out, progress=not args.quiet, validate_start=True)
     return 0
 
 
@@ -497,8 +488,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
     data = e.add_mutually_exclusive_group()
     data.add_argument("--data", default="synthetic-indoor",
-                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ "
-                           "(lipjax.data.folder layout)")
+                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ depth/ [sparse/] "
+                           "(lipjax.data.folder layout): every frame, its own sparse/ maps as input when it has them")
     data.add_argument("--source", default=None, choices=SOURCES,
                       help="a training data source, read as training reads it (lipjax.data.sources); its default "
                            "protocol's crop and depth range unless --protocol says otherwise")
@@ -506,15 +497,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
     e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", default=None, choices=("train", "val", "test"),
-                   help="synthetic split (default test); with --source train or val (default val); --source rendered "
-                        "takes none: it scores the render's frames")
+                   help="synthetic split (default test); FOLDER: train or val as lipjax train splits it (default: "
+                        "every frame); with --source train or val (default val); --source rendered takes none")
     e.add_argument("--kind", default=None, choices=("indoor", "outdoor"),
                    help="the scenes of --source synthetic (default indoor); its depth range follows")
     e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="synthetic render size (default 256 320)")
-    e.add_argument("--sampler", default="uniform:200",
-                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling); with --source "
-                        "also input[:N], the data set's own sparse input (KITTI's scan)")
+    e.add_argument("--sampler", default=None,
+                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling), or input[:N], the "
+                        "data's own sparse input (a FOLDER's sparse/, KITTI's scan). Default: input for a FOLDER "
+                        "with sparse/, else uniform:200")
     e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS) + [NO_PROTOCOL],
                    help="named crop/resize + depth range applied to each frame (lipjax.data.protocols); none: "
                         "frames as they are (with --source, still the source's depth range)")
@@ -566,9 +558,11 @@ def build_parser() -> argparse.ArgumentParser:
     t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames (lipjax.train.folder)")
     t.add_argument("--data", required=True,
                    help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
-    t.add_argument("--out", required=True, help="model path stem to export to (then: lipjax complete --model OUT)")
+    t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
+                   "complete --model OUT)")
     t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
-    t.add_argument("--init", default="lip-cnn-indoor", help="model to start from: shipped name or saved path")
+    t.add_argument("--init", default=None, help="model to start from: shipped name or saved path (default: the "
+                   "default model of the frames' scene, as lipjax complete picks it)")
     t.add_argument("--steps", type=console.positive_int, default=None, help="training steps (default 2000)")
     t.add_argument("--batch-size", type=console.positive_int, default=8)
     t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
@@ -576,7 +570,7 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="default 128 160")
     t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")
-    t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<folder name>)")
+    t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<--out name>)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=_cmd_train)
     return parser

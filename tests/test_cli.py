@@ -308,8 +308,43 @@ def test_evaluate_lidar_sampler_on_a_folder_without_intrinsics_asks_for_them(tmp
     rc = cli.main(["evaluate", "--method", "nearest", "--data", str(tmp_path / "data"), "--sampler", "lidar:hdl64",
                    "--max-depth-m", "10", "--quiet"])
     line = _one_error_line(capsys.readouterr().err)
-    assert rc == 1 and "lidar:hdl64 simulates a LiDAR and needs the camera intrinsics" in line
+    assert rc == 1 and "sampler 'lidar:hdl64' simulates a LiDAR and needs the camera intrinsics" in line
     assert "--intrinsics fx fy cx cy" in line and "intrinsics.txt" in line
+
+
+def _own_data_folder(root, frames=10):
+    """rgb/ depth/ sparse/ .npy frames, no intrinsics: ground truth 2 + i / 10 m everywhere, the sparse maps hold
+    it plus 1 m at 12 pixels, so a nearest fill of sparse/ is 1 m off everywhere (and 0 m off from GT samples)."""
+    for sub in ("rgb", "depth", "sparse"):
+        (root / sub).mkdir(parents=True)
+    for i in range(frames):
+        rgb, sparse = _frame(seed=i, h=12, w=16)
+        depth = np.full((12, 16), 2 + i / 10, np.float32)
+        cv2.imwrite(str(root / "rgb" / f"{i:03d}.png"), rgb[..., ::-1])
+        np.save(root / "depth" / f"{i:03d}.npy", depth)
+        np.save(root / "sparse" / f"{i:03d}.npy", np.where(np.arange(192).reshape(12, 16) % 16 == 5, depth + 1, 0))
+
+
+def test_evaluate_own_folder_scores_its_sparse_maps_on_every_frame_without_intrinsics(tmp_path, capsys):
+    _own_data_folder(tmp_path / "mine")
+    args = ["evaluate", "--method", "nearest", "--data", str(tmp_path / "mine"), "--max-depth-m", "10", "--quiet",
+            "--columns", "rmse_m", "--json", str(tmp_path / "r.json")]
+    assert cli.main(args) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == (f"data: {tmp_path / 'mine'}, every frame (10 frames), sampler: input (the data's own sparse "
+                      "maps), depth range: (0, 10] m")
+    result = json.loads((tmp_path / "r.json").read_text())["nearest"]
+    assert result["num_images"] == 10 and result["metrics"]["rmse_m"] == pytest.approx(1.0, abs=1e-5)
+    assert cli.main(args + ["--split", "val"]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == (
+        f"data: {tmp_path / 'mine'}, val split: the last 5 % of the frames, as lipjax train holds them out (1 frames), "
+        "sampler: input (the data's own sparse maps), depth range: (0, 10] m")
+    assert cli.main(args + ["--sampler", "uniform:20"]) == 0  # samples of the ground truth: exact
+    assert json.loads((tmp_path / "r.json").read_text())["nearest"]["metrics"]["rmse_m"] == pytest.approx(0, abs=1e-6)
+    capsys.readouterr()
+    assert cli.main(["evaluate", "--method", "nearest", "--source", "folder", "--root", str(tmp_path / "mine"),
+                     "--sampler", "input", "--max-depth-m", "10", "--quiet", "--columns", "rmse_m"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].startswith(f"data: folder val ({tmp_path / 'mine'}) (1 frames)")
 
 
 def test_subprocess_error_has_no_traceback(tmp_path):

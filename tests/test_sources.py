@@ -332,18 +332,55 @@ def test_lipjax_evaluate_reads_a_source_as_training_does(tmp_path, capsys):
 
 
 def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
-    """`lipjax train --data DIR` (= lip_cnn_folder: fine-tunes the shipped lip-cnn-indoor), then `lipjax complete`."""
+    """`lipjax train --data DIR --init lip-cnn-indoor` (= lip_cnn_folder), then `lipjax complete`."""
     root = make_folder(tmp_path / "folder")
     model = tmp_path / "model"
     train = subprocess.run([sys.executable, "-m", "lipjax.cli", "train", "--data", str(root), "--out", str(model),
                             "--depth-scale", "1000", "--steps", "2", "--batch-size", "2", "--crop", "24", "32",
-                            "--workers", "0",
+                            "--workers", "0", "--init", "lip-cnn-indoor",
                             "--workdir", str(tmp_path / "run"), "--quiet"], capture_output=True, text=True, timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
                     "--depth-scale", "1000")
     assert done.returncode == 0, done.stderr[-3000:]
     assert np.load(tmp_path / "out.npy").shape == (H, W)
+
+
+def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_and_validates_at_0_and_the_end(
+        tmp_path, capsys, monkeypatch):
+    """Without --init, `lipjax train` fine-tunes the default model of the frames' scene (lipjax.inputs.DEFAULT_MODELS,
+    here a tiny stand-in) and says so in one line; no intrinsics are needed for point samplers; the validation score
+    of the starting model (step 0) and of the result are printed and logged; the model and the run are named after
+    --out."""
+    import lipjax.inputs
+    from lipjax import cli, model_io
+    from lipjax.train.folder import default_init, folder_config
+    from lipjax.train.run import logged_validation
+
+    stem = tmp_path / "tiny"
+    model_io.save(stem, CONFIG.model, init_state(CONFIG).g_params)
+    monkeypatch.setitem(lipjax.inputs.DEFAULT_MODELS, "indoor", str(stem))
+    root = make_folder(tmp_path / "folder")
+    (root / "intrinsics.txt").unlink()
+    out = tmp_path / "models" / "mine"
+    assert cli.main(["train", "--data", str(root), "--out", str(out), "--depth-scale", "1000", "--steps", "2",
+                     "--batch-size", "2", "--crop", "24", "32", "--workers", "0",
+                     "--workdir", str(tmp_path / "run")]) == 0
+    captured = capsys.readouterr()
+    init, scene, why = default_init(root=str(root), depth_scale=1000.0)
+    assert (init, scene) == (str(stem), "indoor")
+    assert captured.err.splitlines()[0] == f"init: {stem}, the default for indoor input ({why}); choose another with " \
+                                           "--init"
+    start, end = (logged_validation(tmp_path / "run" / "metrics.jsonl", step) for step in (0, 2))
+    config = folder_config(CONFIG.model, str(stem), root=str(root), depth_scale=1000.0, crop=CROP, num_workers=0)
+    want = loop.evaluate_params(CONFIG.model, model_io.load(stem)[1], loop.validation_batches(config), 10.0)
+    assert start["rmse_m"] == pytest.approx(want["rmse_m"], rel=1e-6)
+    lines = captured.out.splitlines()
+    assert f"[lipjax] step 0 (start) val rmse_m={start['rmse_m']:.4f} mae_m={start['mae_m']:.4f}" in lines
+    assert lines[-1] == (f"[lipjax] exported mine (step 2) to {out}: val rmse_m={end['rmse_m']:.4f} "
+                         f"({start['rmse_m']:.4f} at step 0)")
+    meta = model_io.metadata(out)
+    assert meta["train_config"] == "mine" and meta["val_metrics"]["rmse_m"] == end["rmse_m"]
 
 
 def test_lipjax_train_checks_its_output_folder_and_every_frame_before_training(tmp_path, capsys):

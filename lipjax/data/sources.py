@@ -31,7 +31,7 @@ import numpy as np
 from lipjax.data.errors import dataset_error
 from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
-from lipjax.data.sampling import SparseSampler, example_rng, sampler_from_spec, subsample_exact
+from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
 
 SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_selection", "kitti_odometry", "tartanair",
            "folder")
@@ -112,6 +112,12 @@ def _own_points(spec: str) -> int | None:
         raise ValueError(f"sampler spec {spec!r}: expected 'input' or 'input:N' with an integer N") from None
 
 
+def uses_intrinsics(spec: str) -> bool:
+    """Whether the sparse input of `spec` (a lipjax.data.sampling spec, or "input[:N]") reads the camera
+    intrinsics: only the LiDAR simulation does."""
+    return spec.split(":")[0].strip() != OWN_INPUT and draws_scan_lines(spec)
+
+
 def _folder_root(root: Path, split: str) -> tuple[Path, bool]:
     """(folder holding rgb/ and depth/ for this split, whether the split is a folder of its own)."""
     if (root / "train").is_dir() and (root / "val").is_dir():
@@ -177,7 +183,9 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         from lipjax.data.folder import FolderDataset
 
         folder, own_split = _folder_root(Path(root), split)
-        dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}")
+        spec = data.train_sampler if split == "train" else data.val_sampler
+        dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}",
+                                intrinsics_needed=uses_intrinsics(spec))
         own = FolderInput(os.fspath(folder / "sparse"), data.depth_scale, dataset.id_prefix)
         if own_split:
             return dataset, own
