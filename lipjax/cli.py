@@ -1,13 +1,12 @@
-"""The `lipjax` command: complete depth on your own images, evaluate, export, list models. It parses arguments
-and calls the library (lipjax.inference, lipjax.data.folder, lipjax.pointcloud, lipjax.evaluate, lipjax.export);
-each subcommand is one `_cmd_*` function registered in `build_parser`.
+"""lipjax: depth completion of your own frames (an RGB image and sparse depth or a LiDAR sweep), evaluation,
+fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
-                    [--uncertainty FILE] [--max-uncertainty M]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
-    lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
+    lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
@@ -16,6 +15,8 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
     lipjax models
     lipjax --version
 
+Run `lipjax COMMAND --help` for a command's options.
+
 `complete`, inputs and outputs:
   --rgb     colour image (.png / .jpg), or a folder of them.
   --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
@@ -23,25 +24,24 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
                     names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
               .npy  float metres (never scaled; --depth-scale then only sets the scale of .png output).
   --lidar   instead of --depth: a LiDAR sweep (KITTI .bin, .npy (N, >=3) x y z metres, or .pcd), projected into
-            the image with --calib (the nearest point per pixel, lipjax.data.lidar): KITTI object calib .txt,
-            a KITTI raw date folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar
-            (lipjax.data.calib); --camera picks KITTI's image (2 = image_2, the default; 3 = image_3). The
-            calibration's intrinsics serve --ply too.
+            the image with --calib (the nearest point per pixel): KITTI object calib .txt, a KITTI raw date
+            folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar; --camera picks
+            KITTI's image (2 = image_2, the default; 3 = image_3). The calibration's intrinsics serve --ply too.
   --out     the extension chooses the format:
               X.npy        float32 metres.
               X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
                            (npy input); values above 65535 are clipped, with a warning.
-              X.color.png  8-bit colour picture (lipjax.viz.colorize_depth, turbo) over --color-range; by
-                           default 0 m to the model's max depth (10 m indoor, 85 m outdoor), or to the output's
-                           99th percentile when that is beyond the model's range or under a quarter of it
-                           (lipjax.viz.fitting_range; with folders, the first frame's); black = no depth.
+              X.color.png  8-bit colour picture (turbo colour map) over --color-range; by default 0 m to the
+                           model's max depth (10 m indoor, 85 m outdoor), or to the output's 99th percentile
+                           when that is beyond the model's range or under a quarter of it (with folders, the
+                           first frame's); black = no depth.
             With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
             (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
             Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
-            (rgb_00050.jpg <-> sync_depth_00050.png), as lipjax.data.folder.FolderDataset does.
+            (rgb_00050.jpg <-> sync_depth_00050.png).
   --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
             metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
-  --uncertainty  also write the expected absolute error of the completed depth (lipjax.uncertainty), metres:
+  --uncertainty  also write the expected absolute error of the completed depth, metres:
             X.npy float32 metres, or X.png a colour picture (dark blue 0 m to dark red >= --max-uncertainty, or
             10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
   --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
@@ -49,19 +49,21 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
   --fill-all  write depth at every pixel. Without it, pixels that no sample supports are 0 (no depth) in --out
             and --ply: those more than one sample spacing s above the highest sample of their column (sky, above
             the top LiDAR beam), and those farther than 3 s from every sample (s = sqrt(area of the samples'
-            bounding box / their number), pixels; lipjax.uncertainty.support_mask). --uncertainty keeps every pixel.
+            bounding box / their number), pixels). --uncertainty keeps every pixel.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
-in training (lipjax.resolution: 200 points on 640x480 run at about half size; a 64-beam scan at full size); a new
-size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
-pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are
-never averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured
-values exactly. `--max-side N` overrides the working size: the longer side becomes at most N pixels.
+in training (200 points on 640x480 run at about half size; a 64-beam scan at full size); a new size costs one
+compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the pixel of the
+small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never averaged);
+the result is resized back (bilinear) and the measured pixels are then set to their measured values exactly.
+`--max-side N` overrides the working size: the longer side becomes at most N pixels.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
 A frame above 2 Mpixel run without --max-side gets a one-line hint.
 """
+# For developers: each subcommand is one `_cmd_*` function registered in `build_parser`; it parses its arguments
+# and calls the library (lipjax.inference, lipjax.data.folder, lipjax.pointcloud, lipjax.evaluate, lipjax.export).
 from __future__ import annotations
 
 import argparse
@@ -73,6 +75,8 @@ from lipjax import console
 
 PROG = "lipjax"
 DEFAULT_PNG_OUT_SCALE = 256.0
+# `lipjax --help` shows the overview; `lipjax complete --help` the details of `complete`, below it.
+_OVERVIEW, _, _COMPLETE_DETAILS = __doc__.partition("`complete`, inputs and outputs:\n")
 CLIError = console.UserError
 
 
@@ -344,22 +348,16 @@ def _cmd_export(args) -> int:
 
 def _cmd_models(args) -> int:
     from lipjax import model_io
-    from lipjax.inference import DEFAULT_MODEL
+    from lipjax.inputs import DEFAULT_MODELS
 
-    names = model_io.available()
-    if not names:
+    if not model_io.available():
         print(f"no shipped models in {model_io.WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. "
               "Train one with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
         return 0
-    for name in names:
-        meta = model_io.metadata(name)
-        rmse = meta.get("val_metrics", {}).get("rmse_m")
-        parts = [name + (" (default)" if name == DEFAULT_MODEL else ""), model_io.summary(name)]
-        if rmse is not None:
-            parts.append(f"val rmse_m={rmse:.4f} ({meta.get('val_sampler', '?')}, {meta.get('data', '?')})")
-        if "images_seen" in meta:
-            parts.append(f"trained on {meta['images_seen']:,} images")
-        print("  ".join(parts))
+    print(model_io.table(DEFAULT_MODELS))
+    print("\nDEFAULT: lipjax complete picks the indoor default for scattered samples, the outdoor default for LiDAR "
+          "scan lines\nor a median sample depth over 12 m; --model NAME overrides it. TYPE: LIP and its prox, or an "
+          "end-to-end network.")
     return 0
 
 
@@ -415,7 +413,7 @@ def _add_lidar_args(parser, required: bool) -> None:
                         help="LiDAR sweep: KITTI .bin, .npy (N, >=3) x y z metres, or .pcd")
     parser.add_argument("--calib", required=required, default=None, metavar="FILE",
                         help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig "
-                             ".txt/.yaml with K and T_cam_from_lidar (lipjax.data.calib)")
+                             ".txt/.yaml with K and T_cam_from_lidar")
     parser.add_argument("--camera", type=int, default=2, metavar="N",
                         help="the KITTI camera of --rgb: 2 (image_2, default) or 3")
 
@@ -439,14 +437,16 @@ def build_parser() -> argparse.ArgumentParser:
     from lipjax.data import protocols
     from lipjax.data.folder import OUT_FORMATS
     from lipjax.data.sources import NO_PROTOCOL, SOURCES
+    from lipjax.evaluate import DEFAULT_COLUMNS
 
-    parser = console.ArgumentParser(prog=PROG, description=__doc__,
+    parser = console.ArgumentParser(prog=PROG, description=_OVERVIEW,
                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    c = sub.add_parser("complete", help="complete sparse depth of your own frames",
+                       description="Completes the sparse depth of your own frames.\n\nInputs and outputs:\n"
+                                   + _COMPLETE_DETAILS, formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
     c.add_argument("--depth", default=None,
                    help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
@@ -455,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output "
                         "(default 256)")
     c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path "
-                   "(also any lipjax.methods name, e.g. ip_basic)")
+                   "(also a classical fill: nearest, linear, ip_basic, colorization, lip-wavelet)")
     c.add_argument("--iterations", type=console.positive_int, default=None, metavar="K",
                    help="run the first K ADMM iterations")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
@@ -483,16 +483,16 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
                        "data source (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
-                   help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
-                        "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
+                   help="shipped model, saved model path, or a classical fill (nearest, linear, ip_basic, "
+                        "colorization, lip-wavelet); repeat to compare (default: the default model of the input)")
     e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
     data = e.add_mutually_exclusive_group()
     data.add_argument("--data", default="synthetic-indoor",
-                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ depth/ [sparse/] "
-                           "(lipjax.data.folder layout): every frame, its own sparse/ maps as input when it has them")
+                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ depth/ [sparse/] (or train/ "
+                           "and val/ holding them): every frame, its own sparse/ maps as input when it has them")
     data.add_argument("--source", default=None, choices=SOURCES,
-                      help="a training data source, read as training reads it (lipjax.data.sources); its default "
-                           "protocol's crop and depth range unless --protocol says otherwise")
+                      help="a training data source, read as training reads it; its default protocol's crop and "
+                           "depth range unless --protocol says otherwise")
     e.add_argument("--root", default=None, metavar="DIR",
                    help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
     e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
@@ -504,12 +504,12 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="synthetic render size (default 256 320)")
     e.add_argument("--sampler", default=None,
-                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling), or input[:N], the "
+                   help="sparse input spec, e.g. uniform:200, bernoulli:500, lidar:hdl64, or input[:N], the "
                         "data's own sparse input (a FOLDER's sparse/, KITTI's scan). Default: input for a FOLDER "
                         "with sparse/, else uniform:200")
     e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS) + [NO_PROTOCOL],
-                   help="named crop/resize + depth range applied to each frame (lipjax.data.protocols); none: "
-                        "frames as they are (with --source, still the source's depth range)")
+                   help="named crop/resize + depth range applied to each frame; none: frames as they are (with "
+                        "--source, still the source's depth range)")
     e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
                    help="for PNG ground truth in FOLDER (or --source folder)")
     intr = e.add_mutually_exclusive_group()
@@ -521,7 +521,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", default=None,
-                   help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
+                   help=f"comma-separated metric names (default: {','.join(DEFAULT_COLUMNS)})")
     e.add_argument("--json", default=None, metavar="FILE", help="also write all results as JSON")
     e.add_argument("--quiet", action="store_true")
     e.set_defaults(func=_cmd_evaluate)
@@ -541,7 +541,7 @@ def build_parser() -> argparse.ArgumentParser:
     m.set_defaults(func=_cmd_models)
     d = sub.add_parser("data", help="data sets: `lipjax data render` writes the synthetic scenes to disk")
     r = d.add_subparsers(dest="data_command", required=True, metavar="ACTION").add_parser(
-        "render", help="render synthetic frames into shard files (lipjax.data.rendered) in worker processes")
+        "render", help="render synthetic frames into shard files, in worker processes")
     r.add_argument("--kind", required=True, choices=("indoor", "outdoor"))
     r.add_argument("--split", default="train", choices=("train", "val", "test"))
     r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
@@ -555,9 +555,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=_cmd_data_render)
 
-    t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames (lipjax.train.folder)")
+    t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames")
     t.add_argument("--data", required=True,
-                   help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
+                   help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated LiDAR only], or train/ and "
+                        "val/ holding them")
     t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
                    "complete --model OUT)")
     t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
@@ -566,7 +567,7 @@ def build_parser() -> argparse.ArgumentParser:
     t.add_argument("--steps", type=console.positive_int, default=None, help="training steps (default 2000)")
     t.add_argument("--batch-size", type=console.positive_int, default=8)
     t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
-                   "points), or input[:N] for your sparse/ maps (lipjax.data.sources)")
+                   "points), or input[:N] for your sparse/ maps")
     t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="default 128 160")
     t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")

@@ -3,6 +3,7 @@ and every user error is one line "lipjax: error: ..." with exit status 1 and no 
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -274,6 +275,17 @@ def _one_error_line(err, prog="lipjax"):
     return lines[0]
 
 
+@pytest.mark.parametrize("command", [[], ["complete"], ["project"], ["evaluate"], ["export"], ["models"], ["train"],
+                                     ["data"], ["data", "render"]])
+def test_help_pages_speak_to_users_not_developers(command, capsys):
+    """No function or module names of the code (`_cmd_*`, build_parser, lipjax.<module>) in any --help page."""
+    assert cli.main(command + ["--help"]) == 0
+    page = capsys.readouterr().out
+    assert page.startswith("usage: lipjax") and re.search(r"_cmd_|build_parser|lipjax\.[a-z]", page) is None, page
+    if not command:  # the overview names every command and points to their pages
+        assert "Run `lipjax COMMAND --help` for a command's options." in page and "--rgb     colour" not in page
+
+
 def test_version(capsys):
     with pytest.raises(SystemExit) as exit_:
         cli.build_parser().parse_args(["--version"])
@@ -361,15 +373,26 @@ def test_subprocess_error_has_no_traceback(tmp_path):
     assert result.stderr.startswith("lipjax: error: ") and "Traceback" not in result.stderr, result.stderr
 
 
-def test_models_command_says_what_each_model_is(capsys):
+def test_models_command_is_a_table_in_aligned_columns_marking_every_default(capsys):
+    from lipjax.inputs import DEFAULT_MODELS
+
     assert cli.main(["models"]) == 0
-    out = capsys.readouterr().out
-    assert all(name in out for name in lipjax.available_models()) and out.strip()
-    assert "None" not in out
-    for line in out.splitlines():
-        assert ("LIP, " in line and " iterations, " in line) or "network (end to end)" in line, line
-        assert " max depth " in line and line.split(" max depth ")[1].split()[0].replace(".", "").isdigit(), line
-        assert " trained on " in line and line.endswith(" images"), line  # every shipped model states its budget
+    lines = capsys.readouterr().out.splitlines()
+    header, rows = lines[0], lines[1:1 + len(lipjax.available_models())]
+    assert header.split() == ["MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL", "RMSE", "VALIDATED", "ON",
+                              "TRAINED", "ON"]
+    starts = [header.index(c) for c in model_io.TABLE_COLUMNS] + [None]
+    cells = [[row[a:b].strip() for a, b in zip(starts, starts[1:])] for row in rows]
+    for row, cell in zip(rows, cells):  # every cell starts at its column: no text runs across a column edge
+        assert all(row[a - 1] == " " for a in starts[1:-1] if a < len(row)), row
+    assert [c[0] for c in cells] == lipjax.available_models() and "None" not in "".join(rows)
+    defaults = {c[0]: c[1] for c in cells if c[1]}
+    marks = {name: ", ".join(s for s, m in DEFAULT_MODELS.items() if m == name) for name in DEFAULT_MODELS.values()}
+    assert defaults == marks  # each default marked with its scene(s), and only they
+    for c in cells:
+        assert c[2].startswith("LIP, ") and c[3].isdigit() or c[3] == c[4] == "-", c
+        assert c[5] in ("10 m", "85 m") and c[6].endswith(" m") and c[8].endswith(" images"), c
+    assert max(len(line) for line in lines) < 120
 
 
 def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
