@@ -364,8 +364,13 @@ def _cmd_models(args) -> int:
 def _cmd_data_render(args) -> int:
     from lipjax.data.rendered import render_to_disk
 
-    out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
-                         window=args.window, workers=args.workers, progress=not args.quiet)
+    try:
+        out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
+                             window=args.window, workers=args.workers, progress=not args.quiet)
+    except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C, SIGTERM: the workers are stopped already
+        print(f"{PROG}: render stopped; its finished shards stay in {args.out}, and the same command finishes it",
+              file=sys.stderr)
+        return 130 if isinstance(stop, KeyboardInterrupt) else stop.code
     print(f"rendered {args.count} {args.kind}/{args.split} frames to {out}")
     return 0
 
