@@ -324,17 +324,19 @@ def test_evaluate_lidar_sampler_on_a_folder_without_intrinsics_asks_for_them(tmp
     assert "--intrinsics fx fy cx cy" in line and "intrinsics.txt" in line
 
 
-def _own_data_folder(root, frames=10):
+def _own_data_folder(root, frames=10, names=("", "", "")):
     """rgb/ depth/ sparse/ .npy frames, no intrinsics: ground truth 2 + i / 10 m everywhere, the sparse maps hold
-    it plus 1 m at 12 pixels, so a nearest fill of sparse/ is 1 m off everywhere (and 0 m off from GT samples)."""
+    it plus 1 m at 12 pixels, so a nearest fill of sparse/ is 1 m off everywhere (and 0 m off from GT samples).
+    names: the stems' prefixes in rgb/, depth/, sparse/ (frames then pair by number)."""
     for sub in ("rgb", "depth", "sparse"):
         (root / sub).mkdir(parents=True)
     for i in range(frames):
         rgb, sparse = _frame(seed=i, h=12, w=16)
         depth = np.full((12, 16), 2 + i / 10, np.float32)
-        cv2.imwrite(str(root / "rgb" / f"{i:03d}.png"), rgb[..., ::-1])
-        np.save(root / "depth" / f"{i:03d}.npy", depth)
-        np.save(root / "sparse" / f"{i:03d}.npy", np.where(np.arange(192).reshape(12, 16) % 16 == 5, depth + 1, 0))
+        cv2.imwrite(str(root / "rgb" / f"{names[0]}{i:03d}.png"), rgb[..., ::-1])
+        np.save(root / "depth" / f"{names[1]}{i:03d}.npy", depth)
+        np.save(root / "sparse" / f"{names[2]}{i:03d}.npy",
+                np.where(np.arange(192).reshape(12, 16) % 16 == 5, depth + 1, 0))
 
 
 def test_evaluate_own_folder_scores_its_sparse_maps_on_every_frame_without_intrinsics(tmp_path, capsys):
@@ -357,6 +359,15 @@ def test_evaluate_own_folder_scores_its_sparse_maps_on_every_frame_without_intri
     assert cli.main(["evaluate", "--method", "nearest", "--source", "folder", "--root", str(tmp_path / "mine"),
                      "--sampler", "input", "--max-depth-m", "10", "--quiet", "--columns", "rmse_m"]) == 0
     assert capsys.readouterr().out.splitlines()[0].startswith(f"data: folder val ({tmp_path / 'mine'}) (1 frames)")
+
+
+def test_evaluate_own_folder_pairs_sparse_maps_by_number_as_it_pairs_depth(tmp_path, capsys):
+    """NYU/BTS-style names (rgb_000.png, sync_depth_000.npy): the sparse maps pair with the frames by number too."""
+    _own_data_folder(tmp_path / "mine", frames=3, names=("rgb_", "sync_depth_", "sync_depth_"))
+    assert cli.main(["evaluate", "--method", "nearest", "--data", str(tmp_path / "mine"), "--max-depth-m", "10",
+                     "--quiet", "--json", str(tmp_path / "r.json")]) == 0
+    assert "every frame (3 frames), sampler: input (the data's own sparse maps)" in capsys.readouterr().out
+    assert json.loads((tmp_path / "r.json").read_text())["nearest"]["metrics"]["rmse_m"] == pytest.approx(1.0)
 
 
 def test_subprocess_error_has_no_traceback(tmp_path):

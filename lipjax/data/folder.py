@@ -234,6 +234,12 @@ def _trailing_number(stem: str) -> str | None:
     return match.group(1) if match else None
 
 
+def files_by_number(directory: Path, suffixes: tuple[str, ...] = DEPTH_SUFFIXES) -> dict[str, Path]:
+    """The files of `directory` with one of `suffixes`, keyed by the number their stems end with, as frames pair
+    by number (rgb_00050.jpg, sync_depth_00050.png: "00050"); stems that end in none are left out."""
+    return {n: p for stem, p in _list(Path(directory), suffixes).items() if (n := _trailing_number(stem)) is not None}
+
+
 def pair_frames(rgb_dir: Path, depth_dir: Path) -> list[tuple[str, Path, Path]]:
     """(key, rgb path, depth path) of every frame, in natural order. Frames pair by file stem; when no stem
     matches, by the number the stem ends with. An RGB image without depth (or the reverse) is an error."""

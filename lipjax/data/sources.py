@@ -22,6 +22,7 @@ Depth in metres throughout; `DataConfig` (lipjax.train.config) names the source,
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 from pathlib import Path
 from typing import Any
@@ -88,20 +89,31 @@ class FolderInput:
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
         from lipjax.data.folder import read_depth
 
-        stem = sample.id[len(self.id_prefix) + 1:]
-        for suffix in (".png", ".npy"):
-            path = Path(self.directory) / f"{stem}{suffix}"
-            if path.is_file():
-                sparse = read_depth(path, self.depth_scale if suffix == ".png" else None)
-                break
-        else:
-            raise dataset_error(f"No sparse input for frame {stem!r} (sparse_input 'input' needs sparse/<stem>)",
-                                Path(self.directory) / f"{stem}.png")
+        path = self._path(sample.id[len(self.id_prefix) + 1:])
+        sparse = read_depth(path, self.depth_scale if path.suffix.lower() == ".png" else None)
         if sparse.shape != sample.shape:
             raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ", path)
         if self.num_points is not None:
             sparse = subsample_exact(sparse, self.num_points, example_rng(seed, sample.id))
         return sparse
+
+    def _path(self, key: str) -> Path:
+        """sparse/<key>.png|.npy; for frames paired by number (key "00050": rgb_00050.jpg with
+        sync_depth_00050.png), the sparse map whose stem ends in that number."""
+        directory = Path(self.directory)
+        for suffix in (".png", ".npy"):
+            if (directory / f"{key}{suffix}").is_file():
+                return directory / f"{key}{suffix}"
+        if key in self._by_number:
+            return self._by_number[key]
+        raise dataset_error(f"No sparse input for frame {key!r} (sampler 'input' needs sparse/<stem>, named as in "
+                            "rgb/ or depth/)", directory / f"{key}.png")
+
+    @functools.cached_property
+    def _by_number(self) -> dict[str, Path]:
+        from lipjax.data.folder import files_by_number
+
+        return files_by_number(Path(self.directory)) if Path(self.directory).is_dir() else {}
 
 
 def _own_points(spec: str) -> int | None:
