@@ -46,10 +46,11 @@ Run `lipjax COMMAND --help` for a command's options.
             10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
   --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
             in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
-  --fill-all  write depth at every pixel. Without it, pixels that no sample supports are 0 (no depth) in --out
-            and --ply: those more than one sample spacing s above the highest sample of their column (sky, above
-            the top LiDAR beam), and those farther than 3 s from every sample (s = sqrt(area of the samples'
-            bounding box / their number), pixels). --uncertainty keeps every pixel.
+  --fill-all  write the dense map, depth also where no sample supports it (--max-uncertainty still applies).
+            Without it, those pixels are 0 (no depth) in --out and --ply: pixels more than one sample spacing s
+            above the highest sample of their column (sky, above the top LiDAR beam), and pixels farther than 3 s
+            from every sample (s = sqrt(area of the samples' bounding box / their number), pixels). --uncertainty
+            keeps every pixel.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
 in training (200 points on 640x480 run at about half size; a 64-beam scan at full size); a new size costs one
@@ -480,7 +481,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--max-uncertainty", type=float, default=None, metavar="M",
                    help="depth 0 (none) where the expected error is above M metres, in --out and --ply")
     c.add_argument("--fill-all", action="store_true",
-                   help="write depth at every pixel, also where no sample supports it (default: 0 there)")
+                   help="write the dense map, depth also where no sample supports it (default: 0 there)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
     c.set_defaults(func=_cmd_complete)
     _add_project_parser(sub)
