@@ -91,19 +91,31 @@ def _finite(x):
     return x
 
 
+KEY_METHODS = 4  # methods in a figure: it must read at 100 % on a laptop screen
+
+
+def key_methods(results: dict[str, EvalResult], completers: dict[str, Any], count: int = KEY_METHODS) -> list[str]:
+    """The methods a figure shows, in table order: the `count` - 1 lowest-RMSE ones, and the best method without
+    learned weights (the reference a learned model has to beat); `count` by RMSE when that one is among them."""
+    ranked = sorted(results, key=lambda m: results[m].metrics.get("rmse_m", float("inf")))
+    classical = [m for m in ranked if not isinstance(completers[m], Completer)]
+    chosen = ranked[:count - 1] + [m for m in classical[:1] if m not in ranked[:count - 1]]
+    chosen += [m for m in ranked if m not in chosen][:count - len(chosen)]
+    return [m for m in results if m in chosen]
+
+
 def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inputs: Sequence[np.ndarray],
-                       completers: dict[str, Any], max_depth_m: float, max_error_m: float) -> None:
-    """The paper's Fig. 3 layout: per frame, RGB | sparse input | ground truth | each method's prediction and error."""
+                       completers: dict[str, Any], results: dict[str, EvalResult], max_depth_m: float,
+                       max_error_m: float, sparse_title: str = "sparse input") -> None:
+    """The paper's Fig. 3 as a grid: per frame, RGB | sparse input | ground truth | the key methods' predictions
+    (`key_methods`), each with its error map below (lipjax.viz.save_comparison_grid)."""
     from lipjax import viz
 
-    rows = []
-    for sample, sparse in zip(samples, sparse_inputs):
-        predictions = {name: np.asarray(c(sample.rgb, sparse)) for name, c in completers.items()}
-        rows.append(viz.comparison_row(sample.rgb, sparse, sample.depth, sample.valid, predictions,
-                                       0.0, max_depth_m, max_error_m))
-    viz.save_panel(path, rows, viz.comparison_titles(list(completers)), row_labels=[s.id for s in samples],
-                   colorbars=[("depth [m]", 0.0, max_depth_m, viz.DEFAULT_DEPTH_CMAP),
-                              ("|error| [m]", 0.0, max_error_m, "jet")])
+    shown = key_methods(results, completers)
+    frames = [viz.Comparison(sample.id, sample.rgb, sparse, sample.depth,
+                             {name: np.asarray(completers[name](sample.rgb, sparse)) for name in shown}, sample.valid)
+              for sample, sparse in zip(samples, sparse_inputs)]
+    viz.save_comparison_grid(path, frames, max_depth_m, max_error_m, sparse_title=sparse_title)
 
 
 def config_fields(config) -> dict[str, Any]:

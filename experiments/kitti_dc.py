@@ -85,8 +85,8 @@ def main(argv=None) -> dict:
     table = write_results(out, results, meta, COLUMNS,
                           {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
     frames = [dataset[i] for i in range(2 if args.variant != "smoke" else 1)]
-    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers,
-                       max_depth_m=protocol.max_depth_m, max_error_m=5.0)
+    qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers, results,
+                       max_depth_m=protocol.max_depth_m, max_error_m=5.0, sparse_title=f"input ({sampler_name})")
     print(table)
     return {name: r.metrics for name, r in results.items()}
 

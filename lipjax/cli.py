@@ -1,13 +1,12 @@
-"""The `lipjax` command: complete depth on your own images, evaluate, export, list models. It parses arguments
-and calls the library (lipjax.inference, lipjax.data.folder, lipjax.pointcloud, lipjax.evaluate, lipjax.export);
-each subcommand is one `_cmd_*` function registered in `build_parser`.
+"""lipjax: depth completion of your own frames (an RGB image and sparse depth or a LiDAR sweep), evaluation,
+fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
-                    [--uncertainty FILE] [--max-uncertainty M]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
-    lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler uniform:200]
+    lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo
@@ -16,6 +15,8 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
     lipjax models
     lipjax --version
 
+Run `lipjax COMMAND --help` for a command's options.
+
 `complete`, inputs and outputs:
   --rgb     colour image (.png / .jpg), or a folder of them.
   --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
@@ -23,40 +24,47 @@ each subcommand is one `_cmd_*` function registered in `build_parser`.
                     names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
               .npy  float metres (never scaled; --depth-scale then only sets the scale of .png output).
   --lidar   instead of --depth: a LiDAR sweep (KITTI .bin, .npy (N, >=3) x y z metres, or .pcd), projected into
-            the image with --calib (the nearest point per pixel, lipjax.data.lidar): KITTI object calib .txt,
-            a KITTI raw date folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar
-            (lipjax.data.calib); --camera picks KITTI's image (2 = image_2, the default; 3 = image_3). The
-            calibration's intrinsics serve --ply too.
+            the image with --calib (the nearest point per pixel): KITTI object calib .txt, a KITTI raw date
+            folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar; --camera picks
+            KITTI's image (2 = image_2, the default; 3 = image_3). The calibration's intrinsics serve --ply too.
   --out     the extension chooses the format:
               X.npy        float32 metres.
               X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
                            (npy input); values above 65535 are clipped, with a warning.
-              X.color.png  8-bit colour picture (lipjax.viz.colorize_depth, turbo) over the fixed range
-                           --color-range (default 0 m to the model's max depth: 10 m indoor, 85 m outdoor);
-                           black = no depth.
+              X.color.png  8-bit colour picture (turbo colour map) over --color-range; by default 0 m to the
+                           model's max depth (10 m indoor, 85 m outdoor), or to the output's 99th percentile
+                           when that is beyond the model's range or under a quarter of it (with folders, the
+                           first frame's); black = no depth.
             With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
             (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
             Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
-            (rgb_00050.jpg <-> sync_depth_00050.png), as lipjax.data.folder.FolderDataset does.
+            (rgb_00050.jpg <-> sync_depth_00050.png).
   --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
             metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
-  --uncertainty  also write the expected absolute error of the completed depth (lipjax.uncertainty), metres:
+  --uncertainty  also write the expected absolute error of the completed depth, metres:
             X.npy float32 metres, or X.png a colour picture (dark blue 0 m to dark red >= --max-uncertainty, or
             10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
   --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
             in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
+  --fill-all  write the dense map, depth also where no sample supports it (--max-uncertainty still applies).
+            Without it, those pixels are 0 (no depth) in --out and --ply: pixels more than one sample spacing s
+            above the highest sample of their column (sky, above the top LiDAR beam), and pixels farther than 3 s
+            from every sample (s = sqrt(area of the samples' bounding box / their number), pixels). --uncertainty
+            keeps every pixel.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
-in training (lipjax.resolution: 200 points on 640x480 run at about half size; a 64-beam scan at full size); a new
-size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
-pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are
-never averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured
-values exactly. `--max-side N` overrides the working size: the longer side becomes at most N pixels.
+in training (200 points on 640x480 run at about half size; a 64-beam scan at full size); a new size costs one
+compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the pixel of the
+small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never averaged);
+the result is resized back (bilinear) and the measured pixels are then set to their measured values exactly.
+`--max-side N` overrides the working size: the longer side becomes at most N pixels.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
 A frame above 2 Mpixel run without --max-side gets a one-line hint.
 """
+# For developers: each subcommand is one `_cmd_*` function registered in `build_parser`; it parses its arguments
+# and calls the library (lipjax.inference, lipjax.data.folder, lipjax.pointcloud, lipjax.evaluate, lipjax.export).
 from __future__ import annotations
 
 import argparse
@@ -68,6 +76,8 @@ from lipjax import console
 
 PROG = "lipjax"
 DEFAULT_PNG_OUT_SCALE = 256.0
+# `lipjax --help` shows the overview; `lipjax complete --help` the details of `complete`, below it.
+_OVERVIEW, _, _COMPLETE_DETAILS = __doc__.partition("`complete`, inputs and outputs:\n")
 CLIError = console.UserError
 
 
@@ -124,7 +134,8 @@ def _cmd_complete(args) -> int:
     from lipjax.inputs import scene_reason
     from lipjax.methods import get_completer
     from lipjax.pointcloud import backproject_rgbd, write_ply
-    from lipjax.uncertainty import drop_uncertain, expected_error, write_uncertainty
+    from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported, write_uncertainty
+    from lipjax.viz import fitting_range
 
     if (args.depth is None) == (args.lidar is None):
         raise CLIError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
@@ -170,6 +181,8 @@ def _cmd_complete(args) -> int:
               "metres, never scaled (--depth-scale applies to .png depth, in and out)")
 
     completer = None  # loaded after the first frame is read: input errors come before the slow model load
+    color_range = tuple(args.color_range) if args.color_range else None  # else fitted to the first frame
+    unsupported = pixels = 0  # pixels set to 0 for want of support, and all pixels, over all frames
     progress = jobs
     if len(jobs) > 1 and not args.quiet:
         from tqdm import tqdm
@@ -187,7 +200,6 @@ def _cmd_complete(args) -> int:
                 scene, why = scene_reason(sparse)
                 print(f"model: {completer.name}, the default for {scene} input ({why}); "
                       "choose another with --model", file=sys.stderr)
-            color_range = tuple(args.color_range) if args.color_range else (0.0, _model_max_depth(completer))
             h, w = frame_size(completer, sparse, args.max_side)
             if args.max_side is None and h * w > LARGE_FRAME_PIXELS:
                 _warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) runs "
@@ -201,59 +213,59 @@ def _cmd_complete(args) -> int:
                                   args.max_uncertainty or 0.1 * _model_max_depth(completer))
             if args.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, args.max_uncertainty)
+        if not args.fill_all:
+            masked = mask_unsupported(dense, sparse)
+            unsupported, pixels = unsupported + int(((masked == 0) & (dense > 0)).sum()), pixels + dense.size
+            dense = masked
+        if color_range is None:
+            color_range = fitting_range(dense, _model_max_depth(completer))
         write_depth(out_file, dense, fmt, out_scale, color_range)
         if ply_file is not None:
             ply_file.parent.mkdir(parents=True, exist_ok=True)
             write_ply(ply_file, *backproject_rgbd(dense, rgb, intrinsics))
-    if len(jobs) == 1 and not args.quiet:
-        print(f"wrote {jobs[0][2]}" + (f" and {jobs[0][3]}" if jobs[0][3] else ""), file=sys.stderr)
-    elif not args.quiet:
-        print(f"wrote {len(jobs)} frame(s) to {out}", file=sys.stderr)
+    if not args.quiet:
+        if len(jobs) == 1:
+            wrote = f"{jobs[0][2]}" + (f" and {jobs[0][3]}" if jobs[0][3] else "")
+        else:
+            wrote = f"{len(jobs)} frame(s) to {out}"
+        notes = [f"{100 * unsupported / pixels:.1f} % of the pixels without support set to 0 (--fill-all keeps "
+                 "them)"] if unsupported else []
+        if fmt == "color.png" and not args.color_range:
+            notes.append(f"colours 0-{color_range[1]:.3g} m")
+        print(f"wrote {wrote}" + (f": {'; '.join(notes)}" if notes else ""), file=sys.stderr)
     return 0
 
 
-def _needs_intrinsics(sampler) -> bool:
-    """Whether a sampler (lipjax.data.sampling) uses the camera intrinsics: the LiDAR simulation does."""
-    from lipjax.data.sampling import LidarSampler
-
-    inner = getattr(sampler, "samplers", None) or (getattr(sampler, "sampler", sampler),)
-    return any(isinstance(s, LidarSampler) or (s is not sampler and _needs_intrinsics(s)) for s in inner)
-
-
-def _data_frames(args, sampler, protocol):
-    """(the frames of --data: the synthetic split or FOLDER, no protocol applied yet; the protocol whose depth
-    range applies, or None)."""
+def _data_frames(args, protocol):
+    """(the frames of --data: the synthetic split or FOLDER, no protocol applied yet; their sampler; the sampler's
+    spec; the data in words; the protocol whose depth range applies, or None)."""
     from lipjax.data import protocols
-    from lipjax.data.sample import Intrinsics
+    from lipjax.evaluate import DEFAULT_SAMPLER, open_folder
 
     if args.data in ("synthetic-indoor", "synthetic-outdoor"):
+        from lipjax.data.sampling import sampler_from_spec
         from lipjax.data.synthetic import SyntheticDataset
 
-        kind = args.data.split("-")[1]
+        kind, spec = args.data.split("-")[1], args.sampler or DEFAULT_SAMPLER
         height, width = args.size or (None, None)
         size_kw = {"height": height, "width": width} if args.size else {}
-        return (SyntheticDataset(kind, args.split or "test", **size_kw),
+        return (SyntheticDataset(kind, args.split or "test", **size_kw), sampler_from_spec(spec), spec, args.data,
                 protocol or protocols.get_protocol(f"synthetic_{kind}"))
-    from lipjax.data.folder import FolderDataset
-
     root = Path(args.data)
     if not root.is_dir():
         raise CLIError(f"--data {args.data}: not synthetic-indoor, synthetic-outdoor or a folder")
-    intrinsics = _intrinsics_from_args(args)
-    if intrinsics is None and not (root / "intrinsics.txt").is_file() and not (root / "intrinsics").is_dir():
-        if _needs_intrinsics(sampler):
-            raise CLIError(f"--sampler {args.sampler} simulates a LiDAR and needs the camera intrinsics of the "
-                           f"frames in {root}: pass --intrinsics fx fy cx cy or --intrinsics-file F, or write "
-                           f"{root / 'intrinsics.txt'} (fx fy cx cy)")
-        intrinsics = Intrinsics(1.0, 1.0, 0.0, 0.0)  # unused: neither this sampler nor the metrics need them
-    return FolderDataset(root, depth_scale=args.depth_scale, intrinsics=intrinsics), protocol
+    if args.split == "test":
+        raise CLIError(f"--split test: a folder has train and val frames (--split train|val), or leave --split out "
+                       f"to score every frame of {root}")
+    frames, sampler, spec, which = open_folder(root, args.split, sampler=args.sampler, depth_scale=args.depth_scale,
+                                               intrinsics=_intrinsics_from_args(args))
+    return frames, sampler, spec, f"{args.data}, {which}", protocol
 
 
 def _cmd_evaluate(args) -> int:
     from lipjax.data import protocols
-    from lipjax.data.sampling import sampler_from_spec
-    from lipjax.data.sources import NO_PROTOCOL
-    from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, open_eval_source, save_json
+    from lipjax.data.sources import NO_PROTOCOL, OWN_INPUT
+    from lipjax.evaluate import DEFAULT_COLUMNS, DEFAULT_SAMPLER, evaluate, markdown_table, open_eval_source, save_json
     from lipjax.methods import get_completer
 
     if args.source is None and (args.root is not None or args.raw_root is not None):
@@ -275,8 +287,8 @@ def _cmd_evaluate(args) -> int:
         if args.source == "rendered" and args.split is not None:
             raise CLIError("--split: --source rendered evaluates the frames in --root (their split is the render's); "
                            "drop --split")
-        split = args.split or "val"
-        source, range_from = open_eval_source(args.source, args.root, split, sampler=args.sampler,
+        split, spec = args.split or "val", args.sampler or DEFAULT_SAMPLER
+        source, range_from = open_eval_source(args.source, args.root, split, sampler=spec,
                                               protocol=args.protocol, raw_root=args.raw_root,
                                               depth_scale=args.depth_scale, kind=args.kind)
         dataset, sampler = source.dataset, source.sampler  # protocol applied
@@ -291,11 +303,9 @@ def _cmd_evaluate(args) -> int:
             data_name = f"{args.source}{kind} {split}" + (f" ({args.root})" if args.root else "")
     else:
         protocol = protocols.get_protocol(args.protocol) if args.protocol not in (None, NO_PROTOCOL) else None
-        sampler = sampler_from_spec(args.sampler)
-        dataset, range_from = _data_frames(args, sampler, protocol)
+        dataset, sampler, spec, data_name, range_from = _data_frames(args, protocol)
         if protocol is not None:
             dataset = protocols.ProtocolView(dataset, protocol)
-        data_name = args.data
     min_depth = args.min_depth_m if args.min_depth_m is not None else (range_from.min_depth_m if range_from else 0.0)
     max_depth = args.max_depth_m if args.max_depth_m is not None else (range_from.max_depth_m if range_from else None)
     if max_depth is None:
@@ -303,13 +313,14 @@ def _cmd_evaluate(args) -> int:
                        "or --protocol NAME")
     columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
     results = {}
-    for model in args.model or [None]:
-        completer = get_completer(model, args.iterations)
+    for model in args.model or [None]:  # the default model: the one the first frame's input suggests
+        completer = get_completer(model, args.iterations, sparse=None if model else sampler(dataset[0], args.seed))
         label = model if model is not None else ("untrained" if completer.name == "random" else completer.name)
         results[label] = evaluate(completer, dataset, sampler, min_depth_m=min_depth, max_depth_m=max_depth,
                                   limit=args.limit, progress=not args.quiet, seed=args.seed)
     n = next(iter(results.values())).num_images
-    print(f"data: {data_name} ({n} frames), sampler: {args.sampler}, depth range: ({min_depth:g}, {max_depth:g}] m")
+    own = " (the data's own sparse maps)" if spec.split(":")[0] == OWN_INPUT else ""
+    print(f"data: {data_name} ({n} frames), sampler: {spec}{own}, depth range: ({min_depth:g}, {max_depth:g}] m")
     print()
     print(markdown_table(results, columns=columns))
     if args.json:
@@ -339,47 +350,50 @@ def _cmd_export(args) -> int:
 
 def _cmd_models(args) -> int:
     from lipjax import model_io
-    from lipjax.inference import DEFAULT_MODEL
+    from lipjax.inputs import DEFAULT_MODELS
 
-    names = model_io.available()
-    if not names:
+    if not model_io.available():
         print(f"no shipped models in {model_io.WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. "
               "Train one with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
         return 0
-    for name in names:
-        meta = model_io.metadata(name)
-        rmse = meta.get("val_metrics", {}).get("rmse_m")
-        parts = [name + (" (default)" if name == DEFAULT_MODEL else ""), model_io.summary(name)]
-        if rmse is not None:
-            parts.append(f"val rmse_m={rmse:.4f} ({meta.get('val_sampler', '?')}, {meta.get('data', '?')})")
-        if "images_seen" in meta:
-            parts.append(f"trained on {meta['images_seen']:,} images")
-        print("  ".join(parts))
+    print(model_io.table(DEFAULT_MODELS))
+    print("\nDEFAULT: lipjax complete picks the indoor default for scattered samples, the outdoor default for LiDAR "
+          "scan lines\nor a median sample depth over 12 m; --model NAME overrides it. TYPE: LIP and its prox, or an "
+          "end-to-end network.")
     return 0
 
 
 def _cmd_data_render(args) -> int:
     from lipjax.data.rendered import render_to_disk
 
-    out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
-                         window=args.window, workers=args.workers, progress=not args.quiet)
+    try:
+        out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
+                             window=args.window, workers=args.workers, progress=not args.quiet)
+    except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C, SIGTERM: the workers are stopped already
+        print(f"{PROG}: render stopped; its finished shards stay in {args.out}, and the same command finishes it",
+              file=sys.stderr)
+        return 130 if isinstance(stop, KeyboardInterrupt) else stop.code
     print(f"rendered {args.count} {args.kind}/{args.split} frames to {out}")
     return 0
 
 
 def _cmd_train(args) -> int:
     from lipjax import model_io
-    from lipjax.train.folder import folder_config
+    from lipjax.train.folder import default_init, folder_config
     from lipjax.train.run import run
 
-    model = model_io.load(args.init)[0]
     data = {"root": args.data, "depth_scale": args.depth_scale, "num_workers": args.workers,
             **({"crop": tuple(args.crop)} if args.crop else {}),
             **({"train_sampler": args.sampler} if args.sampler else {})}
-    config = folder_config(model, args.init, **data)
+    init = args.init
+    if init is None:
+        init, scene, why = default_init(**data)
+        if not args.quiet:
+            print(f"init: {init}, the default for {scene} input ({why}); choose another with --init", file=sys.stderr)
+    name = Path(args.out).name
+    config = folder_config(model_io.load(init)[0], init, name=name, **data)
     config = dataclasses.replace(config, batch_size=args.batch_size, **({"g_steps": args.steps} if args.steps else {}))
-    run(config, args.workdir or f"runs/train-{Path(args.data).resolve().name}", export=args.out,
-        progress=not args.quiet)
+    run(config, args.workdir or f"runs/train-{name}", export=args.out, progress=not args.quiet, validate_start=True)
     return 0
 
 
@@ -406,7 +420,7 @@ def _add_lidar_args(parser, required: bool) -> None:
                         help="LiDAR sweep: KITTI .bin, .npy (N, >=3) x y z metres, or .pcd")
     parser.add_argument("--calib", required=required, default=None, metavar="FILE",
                         help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig "
-                             ".txt/.yaml with K and T_cam_from_lidar (lipjax.data.calib)")
+                             ".txt/.yaml with K and T_cam_from_lidar")
     parser.add_argument("--camera", type=int, default=2, metavar="N",
                         help="the KITTI camera of --rgb: 2 (image_2, default) or 3")
 
@@ -430,14 +444,16 @@ def build_parser() -> argparse.ArgumentParser:
     from lipjax.data import protocols
     from lipjax.data.folder import OUT_FORMATS
     from lipjax.data.sources import NO_PROTOCOL, SOURCES
+    from lipjax.evaluate import DEFAULT_COLUMNS
 
-    parser = console.ArgumentParser(prog=PROG, description=__doc__,
+    parser = console.ArgumentParser(prog=PROG, description=_OVERVIEW,
                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    c = sub.add_parser("complete", help="complete sparse depth of your own frames", description=__doc__,
-                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    c = sub.add_parser("complete", help="complete sparse depth of your own frames",
+                       description="Completes the sparse depth of your own frames.\n\nInputs and outputs:\n"
+                                   + _COMPLETE_DETAILS, formatter_class=argparse.RawDescriptionHelpFormatter)
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
     c.add_argument("--depth", default=None,
                    help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
@@ -446,7 +462,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also the scale of .png output "
                         "(default 256)")
     c.add_argument("--model", default=None, help="shipped model name (lipjax models) or saved model path "
-                   "(also any lipjax.methods name, e.g. ip_basic)")
+                   "(also a classical fill: nearest, linear, ip_basic, colorization, lip-wavelet)")
     c.add_argument("--iterations", type=console.positive_int, default=None, metavar="K",
                    help="run the first K ADMM iterations")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
@@ -465,6 +481,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, default=None, metavar="M",
                    help="depth 0 (none) where the expected error is above M metres, in --out and --ply")
+    c.add_argument("--fill-all", action="store_true",
+                   help="write the dense map, depth also where no sample supports it (default: 0 there)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
     c.set_defaults(func=_cmd_complete)
     _add_project_parser(sub)
@@ -472,32 +490,33 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
                        "data source (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append", default=None,
-                   help="shipped model, saved model path, or any lipjax.methods name (lip-wavelet, nearest, "
-                        "linear, ip_basic, colorization); repeat to compare (default: the shipped default model)")
+                   help="shipped model, saved model path, or a classical fill (nearest, linear, ip_basic, "
+                        "colorization, lip-wavelet); repeat to compare (default: the default model of the input)")
     e.add_argument("--iterations", type=console.positive_int, default=None, metavar="K")
     data = e.add_mutually_exclusive_group()
     data.add_argument("--data", default="synthetic-indoor",
-                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ and depth/ "
-                           "(lipjax.data.folder layout)")
+                      help="synthetic-indoor | synthetic-outdoor | FOLDER with rgb/ depth/ [sparse/] (or train/ "
+                           "and val/ holding them): every frame, its own sparse/ maps as input when it has them")
     data.add_argument("--source", default=None, choices=SOURCES,
-                      help="a training data source, read as training reads it (lipjax.data.sources); its default "
-                           "protocol's crop and depth range unless --protocol says otherwise")
+                      help="a training data source, read as training reads it; its default protocol's crop and "
+                           "depth range unless --protocol says otherwise")
     e.add_argument("--root", default=None, metavar="DIR",
                    help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
     e.add_argument("--raw-root", default=None, metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", default=None, choices=("train", "val", "test"),
-                   help="synthetic split (default test); with --source train or val (default val); --source rendered "
-                        "takes none: it scores the render's frames")
+                   help="synthetic split (default test); FOLDER: train or val as lipjax train splits it (default: "
+                        "every frame); with --source train or val (default val); --source rendered takes none")
     e.add_argument("--kind", default=None, choices=("indoor", "outdoor"),
                    help="the scenes of --source synthetic (default indoor); its depth range follows")
     e.add_argument("--size", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="synthetic render size (default 256 320)")
-    e.add_argument("--sampler", default="uniform:200",
-                   help="sparse input spec, e.g. uniform:200, lidar:hdl64 (lipjax.data.sampling); with --source "
-                        "also input[:N], the data set's own sparse input (KITTI's scan)")
+    e.add_argument("--sampler", default=None,
+                   help="sparse input spec, e.g. uniform:200, bernoulli:500, lidar:hdl64, or input[:N], the "
+                        "data's own sparse input (a FOLDER's sparse/, KITTI's scan). Default: input for a FOLDER "
+                        "with sparse/, else uniform:200")
     e.add_argument("--protocol", default=None, choices=sorted(protocols.PROTOCOLS) + [NO_PROTOCOL],
-                   help="named crop/resize + depth range applied to each frame (lipjax.data.protocols); none: "
-                        "frames as they are (with --source, still the source's depth range)")
+                   help="named crop/resize + depth range applied to each frame; none: frames as they are (with "
+                        "--source, still the source's depth range)")
     e.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S",
                    help="for PNG ground truth in FOLDER (or --source folder)")
     intr = e.add_mutually_exclusive_group()
@@ -509,7 +528,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", default=None,
-                   help="comma-separated metric names (default: lipjax.evaluate.DEFAULT_COLUMNS)")
+                   help=f"comma-separated metric names (default: {','.join(DEFAULT_COLUMNS)})")
     e.add_argument("--json", default=None, metavar="FILE", help="also write all results as JSON")
     e.add_argument("--quiet", action="store_true")
     e.set_defaults(func=_cmd_evaluate)
@@ -529,7 +548,7 @@ def build_parser() -> argparse.ArgumentParser:
     m.set_defaults(func=_cmd_models)
     d = sub.add_parser("data", help="data sets: `lipjax data render` writes the synthetic scenes to disk")
     r = d.add_subparsers(dest="data_command", required=True, metavar="ACTION").add_parser(
-        "render", help="render synthetic frames into shard files (lipjax.data.rendered) in worker processes")
+        "render", help="render synthetic frames into shard files, in worker processes")
     r.add_argument("--kind", required=True, choices=("indoor", "outdoor"))
     r.add_argument("--split", default="train", choices=("train", "val", "test"))
     r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
@@ -543,20 +562,23 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true")
     r.set_defaults(func=_cmd_data_render)
 
-    t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames (lipjax.train.folder)")
+    t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames")
     t.add_argument("--data", required=True,
-                   help="folder with rgb/ depth/ [sparse/] and intrinsics (lipjax.data.folder)")
-    t.add_argument("--out", required=True, help="model path stem to export to (then: lipjax complete --model OUT)")
+                   help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated LiDAR only], or train/ and "
+                        "val/ holding them")
+    t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
+                   "complete --model OUT)")
     t.add_argument("--depth-scale", type=_depth_scale, default=None, metavar="S", help="PNG depth value per metre")
-    t.add_argument("--init", default="lip-cnn-indoor", help="model to start from: shipped name or saved path")
+    t.add_argument("--init", default=None, help="model to start from: shipped name or saved path (default: the "
+                   "default model of the frames' scene, as lipjax complete picks it)")
     t.add_argument("--steps", type=console.positive_int, default=None, help="training steps (default 2000)")
     t.add_argument("--batch-size", type=console.positive_int, default=8)
     t.add_argument("--sampler", default=None, help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
-                   "points), or input[:N] for your sparse/ maps (lipjax.data.sources)")
+                   "points), or input[:N] for your sparse/ maps")
     t.add_argument("--crop", type=console.positive_int, nargs=2, default=None, metavar=("H", "W"),
                    help="default 128 160")
     t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")
-    t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<folder name>)")
+    t.add_argument("--workdir", default=None, help="checkpoints and logs (default runs/train-<--out name>)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=_cmd_train)
     return parser

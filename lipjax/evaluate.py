@@ -27,6 +27,7 @@ import statistics
 import sys
 import time
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -142,6 +143,60 @@ def open_eval_source(
                       depth_scale=depth_scale, train_sampler=sampler, val_sampler=sampler, val_images=None,
                       kind=kind, height=height, width=width)
     return open_source(data, split, render_frames=True), range_protocol(data)
+
+
+DEFAULT_SAMPLER = "uniform:200"  # the sparse input where the data have none of their own (the paper's Table I)
+
+
+def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: str | None = None,
+                depth_scale: float | None = None, intrinsics: Any = None) -> tuple[Any, Sampler, str, str]:
+    """The frames of a user's folder (lipjax.data.folder layout) to evaluate, with their sparse input.
+
+    Args:
+      root: holds rgb/ depth/ [sparse/] [intrinsics], or train/ and val/ subfolders that do.
+      split: None: every frame (of val/ where root has train/ and val/); "train" / "val": the frames `lipjax
+        train` trains / validates on (that subfolder, or else the last 5 % of the frames for val, the rest train).
+      sampler: a lipjax.data.sampling spec or "input[:N]" (the folder's own sparse/<stem> maps, as depth/); by
+        default "input" when the folder has sparse/, else DEFAULT_SAMPLER.
+      depth_scale: PNG value per metre of the depth/ and sparse/ PNGs.
+      intrinsics: overrides the folder's (lipjax.data.sample.Intrinsics); read only by a LiDAR-simulating sampler.
+
+    Returns:
+      (frames: an indexable of Samples, the sampler, its spec, which frames in words: "every frame",
+      "val/: every frame", "val split: the last 5 % of the frames, as lipjax train holds them out", ...).
+    """
+    from lipjax.data.errors import dataset_error
+    from lipjax.data.folder import FolderDataset
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.sources import (OWN_INPUT, VAL_TAIL_FRACTION, FolderInput, Subset, folder_split_root, own_points,
+                                     tail_split, uses_intrinsics)
+
+    if split not in (None, "train", "val"):
+        raise ValueError(f"split must be None (every frame), 'train' or 'val', got {split!r}")
+    folder, own_split = folder_split_root(Path(root), split or "val")
+    spec = sampler or (OWN_INPUT if (folder / "sparse").is_dir() else DEFAULT_SAMPLER)
+    own = spec.split(":")[0].strip() == OWN_INPUT
+    if own and not (folder / "sparse").is_dir():
+        raise dataset_error(f"sampler {spec!r} reads the folder's own sparse maps (sparse/<stem>.png|.npy, as "
+                            "depth/), and there are none; add them or use a sampler such as uniform:200, in",
+                            folder / "sparse")
+    has_intrinsics = (folder / "intrinsics.txt").is_file() or (folder / "intrinsics").is_dir()
+    if uses_intrinsics(spec) and intrinsics is None and not has_intrinsics:
+        raise dataset_error(f"sampler {spec!r} simulates a LiDAR and needs the camera intrinsics of the frames: "
+                            "pass them (lipjax evaluate --intrinsics fx fy cx cy or --intrinsics-file F) or write "
+                            "intrinsics.txt (fx fy cx cy) in", folder)
+    dataset = FolderDataset(folder, depth_scale, intrinsics, id_prefix=f"folder/{folder.name}",
+                            intrinsics_needed=uses_intrinsics(spec))
+    draw = (FolderInput(os.fspath(folder / "sparse"), depth_scale, dataset.id_prefix, own_points(spec)) if own
+            else sampler_from_spec(spec))
+    if own_split:
+        return dataset, draw, spec, f"{folder.name}/: every frame"
+    if split is None:
+        return dataset, draw, spec, "every frame"
+    tail = f"the last {100 * VAL_TAIL_FRACTION:g} %"
+    share = tail if split == "val" else f"all but {tail}"
+    return (Subset(dataset, tail_split(["all"] * len(dataset), split)), draw, spec,
+            f"{split} split: {share} of the frames, as lipjax train holds them out")
 
 
 def evaluate(

@@ -126,17 +126,31 @@ def metadata(name_or_path: str | os.PathLike) -> dict:
     return _read_doc(resolve(name_or_path)).get("metadata", {})
 
 
-def summary(name_or_path: str | os.PathLike) -> str:
-    """One line on what a model is, from its config: the type and what that type has (iterations, prox, initial
-    fill, depth range), e.g. "LIP, 3 iterations, network prox, z0 = linear fill, max depth 10 m"."""
-    config = config_from_dict(_read_doc(resolve(name_or_path))["config"])
-    if isinstance(config, LIPConfig):
-        prior = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
-        parts = ["LIP", f"{config.num_iterations} iterations", f"{prior} prox",
-                 f"z0 = {config.initial_estimate} fill"]
-    else:
-        parts = [f"{model_type_name(config)} network (end to end)"]
-    return ", ".join(parts + [f"max depth {config.max_depth_m:g} m"])
+TABLE_COLUMNS = ("MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL RMSE", "VALIDATED ON", "TRAINED ON")
+
+
+def table(defaults: dict[str, str]) -> str:
+    """The shipped models as a text table in aligned columns (TABLE_COLUMNS), one row per model, from each model's
+    config and metadata: DEFAULT names the scene(s) whose default it is (`defaults`: scene -> model name, e.g.
+    lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox> prox" or the end-to-end network's
+    type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
+    (sampler, data); "-" where unknown or not applicable."""
+    rows = [TABLE_COLUMNS]
+    for name in available():
+        config = config_from_dict(_read_doc(resolve(name))["config"])
+        meta = metadata(name)
+        rmse = meta.get("val_metrics", {}).get("rmse_m")
+        if isinstance(config, LIPConfig):
+            prior = {cls: p for p, cls in _prior_types().items()}[type(config.prior)]
+            kind, iters, z0 = f"LIP, {prior} prox", str(config.num_iterations), config.initial_estimate
+        else:
+            kind, iters, z0 = model_type_name(config), "-", "-"
+        rows.append((name, ", ".join(s for s, m in defaults.items() if m == name), kind, iters, z0,
+                     f"{config.max_depth_m:g} m", "-" if rmse is None else f"{rmse:.4f} m",
+                     f"{meta['val_sampler']}, {meta.get('data', '?')}" if "val_sampler" in meta else "-",
+                     f"{meta['images_seen']:,} images" if "images_seen" in meta else "-"))
+    widths = [max(len(r[i]) for r in rows) for i in range(len(TABLE_COLUMNS))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
 
 
 def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:

@@ -1,4 +1,4 @@
-"""Pictures of depth maps: colour maps with a fixed range, error maps, and side-by-side panels (paper Fig. 3).
+"""Pictures of depth maps: colour maps with a fixed range, error maps, panels and comparison figures (Fig. 3).
 
 All functions return uint8 RGB images (H, W, 3) and never change global matplotlib state (no pyplot; the
 colour tables come from `matplotlib.colormaps`, figures are drawn on an Agg canvas).
@@ -6,20 +6,22 @@ colour tables come from `matplotlib.colormaps`, figures are drawn on an Agg canv
 Conventions, fixed so that pictures of different frames and methods compare:
   - `colorize_depth(depth_m, min_m=0, max_m=10, cmap="turbo")`: depth is clipped to [min_m, max_m] metres and
     mapped linearly onto the colour map, near = low end (dark blue for turbo), far = high end (dark red).
-    The range never adapts to the image: pass min_m / max_m (e.g. 0-10 m indoors, 0-80 m outdoors).
+    The range never adapts to the image: pass min_m / max_m (e.g. 0-10 m indoors, 0-80 m outdoors), or
+    `fitting_range(depth_m, max_m)`, the model's range unless the data do not fit it.
     Invalid pixels (depth <= 0, NaN, inf) are black.
   - `error_map(pred, gt, valid, max_error_m=1)`: |pred - gt| in metres on "jet", dark blue (0 m) to dark red
     (>= max_error_m), as the paper's error maps ("the value of the error increases from dark blue to dark red").
     Pixels without valid ground truth are black.
   - `colorize_sparse`: a sparse map with each sample drawn as a small disc, so 200 points stay visible.
 
-A Fig.-3-like figure (RGB | sparse input | GT | per method: prediction, error):
+A Fig.-3-like figure (per frame: RGB | sparse input | GT | each method's prediction, its error map below):
 
-    row = comparison_row(rgb, sparse, gt, valid, {"LIP+AD": pred}, max_m=10, max_error_m=0.5)
-    save_panel("fig3.png", [row], titles=comparison_titles(["LIP+AD"]))
+    frame = Comparison("frame 1", rgb, sparse, gt, {"LIP+AD": pred, "linear": fill})
+    save_comparison_grid("fig3.png", [frame], max_m=10, max_error_m=0.5)
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Mapping, Sequence
 
@@ -61,6 +63,23 @@ def colorize_depth(depth_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
         raise ValueError(f"depth must be (H, W), got shape {depth.shape}")
     valid = np.isfinite(depth) & (depth > 0)
     return _apply(depth, min_m, max_m, valid, cmap)
+
+
+FIT_PERCENTILE = 99.0
+"""The depth percentile (of the valid pixels) that `fitting_range` fits the colour range to."""
+
+
+def fitting_range(depth_m: np.ndarray, max_m: float) -> tuple[float, float]:
+    """A colour range (0, top) metres for `depth_m` (any shape; <= 0, NaN and inf are no depth): (0, max_m),
+    e.g. the model's range, when its FIT_PERCENTILE-th percentile p of the valid depths lies in [max_m / 4, max_m];
+    else (0, p), so that a picture neither saturates (p > max_m) nor uses under a quarter of the colours.
+    (0, max_m) when no pixel has depth."""
+    depth = np.asarray(depth_m, np.float64)
+    valid = depth[np.isfinite(depth) & (depth > 0)]
+    if valid.size == 0:
+        return 0.0, float(max_m)
+    p = float(np.percentile(valid, FIT_PERCENTILE))
+    return (0.0, float(max_m)) if max_m / 4 <= p <= max_m else (0.0, p)
 
 
 def colorize_sparse(sparse_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
@@ -112,64 +131,82 @@ def write_png(path: str | os.PathLike, image: np.ndarray) -> None:
         raise OSError(f"cannot write image {os.fspath(path)!r} (folder missing or unsupported extension?)")
 
 
-def comparison_titles(methods: Sequence[str]) -> list[str]:
-    """Column titles matching `comparison_row`."""
-    return ["RGB", "sparse input", "ground truth"] + [t for m in methods for t in (m, f"{m} error")]
+@dataclasses.dataclass(frozen=True)
+class Comparison:
+    """One frame of a comparison figure: its label, RGB uint8 (H, W, 3), sparse input, ground truth and each
+    method's prediction (metres, (H, W)); `valid` marks the ground truth scored (default gt > 0)."""
+
+    label: str
+    rgb: np.ndarray
+    sparse_m: np.ndarray
+    gt_m: np.ndarray
+    predictions: Mapping[str, np.ndarray]
+    valid: np.ndarray | None = None
 
 
-def comparison_row(rgb: np.ndarray, sparse_m: np.ndarray, gt_m: np.ndarray, valid: np.ndarray | None,
-                   predictions: Mapping[str, np.ndarray], min_m: float = 0.0, max_m: float = 10.0,
-                   max_error_m: float = 1.0, cmap: str = DEFAULT_DEPTH_CMAP) -> list[np.ndarray]:
-    """One row of a Fig.-3-like figure: RGB | sparse input | GT | for each method, prediction and error map.
+def save_comparison_grid(path: str | os.PathLike, frames: Sequence[Comparison], max_m: float, max_error_m: float,
+                         sparse_title: str = "sparse input", cell_inches: float = 1.7, dpi: int = 100,
+                         cmap: str = DEFAULT_DEPTH_CMAP) -> None:
+    """Writes a figure (PNG / PDF / SVG by extension) that reads at 100 %: per frame two rows, RGB | sparse input |
+    ground truth | each method's prediction above, and under each prediction its error map with the frame's RMSE
+    (metres, over the valid ground truth). The frame's label sits under its RGB image; one colour bar for depth
+    [0, max_m] and one for |error| [0, max_error_m] run under the grid with a gap between them. Methods keep the
+    order of each frame's `predictions`; every frame must have the same methods. With the defaults, 3 frames of
+    4 methods at the 4:5 aspect of 256x320 make about 950 x 820 pixels."""
+    import textwrap
 
-    Depths share one fixed colour range [min_m, max_m]; errors share [0, max_error_m]. Methods keep the mapping's
-    order. Use with `save_panel`, titled by `comparison_titles(predictions)`.
-    """
-    valid = (np.asarray(gt_m) > 0) if valid is None else np.asarray(valid, bool)
-    gt_shown = np.where(valid, gt_m, 0)
-    row = [_as_rgb(rgb), colorize_sparse(sparse_m, min_m, max_m, cmap), colorize_depth(gt_shown, min_m, max_m, cmap)]
-    for pred in predictions.values():
-        row += [colorize_depth(pred, min_m, max_m, cmap), error_map(pred, gt_m, valid, max_error_m)]
-    return row
-
-
-def save_panel(path: str | os.PathLike, rows: Sequence[Sequence[np.ndarray]], titles: Sequence[str] | None = None,
-               row_labels: Sequence[str] | None = None, cell_inches: float = 2.0, dpi: int = 150,
-               colorbars: Sequence[tuple[str, float, float, str]] = ()) -> None:
-    """Writes a grid of images as a matplotlib figure (PNG / PDF / SVG by extension), with titles and colour bars.
-
-    Args:
-      rows: rows of uint8 (H, W, 3) or grey (H, W) images, all of one size; all rows the same length.
-      titles: column titles; row_labels: one label per row (left side).
-      colorbars: (label, vmin, vmax, cmap) colour bars drawn under the grid, e.g. ("depth [m]", 0, 10, "turbo").
-    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.cm import ScalarMappable
     from matplotlib.colors import Normalize
     from matplotlib.figure import Figure
 
-    rows = [[_as_rgb(im) for im in row] for row in rows]
-    nrows, ncols = len(rows), max(len(r) for r in rows)
-    h, w = rows[0][0].shape[:2]
-    extra = 0.6 if colorbars else 0.0
-    fig = Figure(figsize=(cell_inches * ncols, cell_inches * nrows * h / w + 0.4 + extra), dpi=dpi)
+    if not frames:
+        raise ValueError("save_comparison_grid needs at least one frame")
+    methods = list(frames[0].predictions)
+    ncols = 3 + len(methods)
+    h, w = np.shape(frames[0].gt_m)
+    cell_h = cell_inches * h / w
+    fig = Figure(figsize=(cell_inches * ncols, len(frames) * (2 * cell_h + 0.2) + 0.9), dpi=dpi)
     FigureCanvasAgg(fig)
-    grid = fig.add_gridspec(nrows + (1 if colorbars else 0), ncols,
-                            height_ratios=[1] * nrows + ([0.08] if colorbars else []), hspace=0.08, wspace=0.03)
-    for r, row in enumerate(rows):
-        for c in range(ncols):
-            ax = fig.add_subplot(grid[r, c])
-            ax.set_xticks([]), ax.set_yticks([])
-            if c < len(row):
-                ax.imshow(row[c], interpolation="nearest")
-            else:
-                ax.set_axis_off()
-            if r == 0 and titles and c < len(titles):
-                ax.set_title(titles[c], fontsize=8)
-            if c == 0 and row_labels and r < len(row_labels):
-                ax.set_ylabel(row_labels[r], fontsize=8)
-    for i, (label, vmin, vmax, cmap) in enumerate(colorbars):
-        span = max(1, ncols // max(1, len(colorbars)))
-        cax = fig.add_subplot(grid[nrows, i * span:(i + 1) * span])
-        fig.colorbar(ScalarMappable(Normalize(vmin, vmax), cmap), cax=cax, orientation="horizontal", label=label)
+    outer = fig.add_gridspec(len(frames) + 1, 1, height_ratios=[2 * cell_h] * len(frames) + [0.35], hspace=0.12)
+
+    def show(ax, image=None):
+        ax.set_xticks([]), ax.set_yticks([])
+        if image is None:
+            ax.set_axis_off()
+        else:
+            ax.imshow(image, interpolation="nearest")
+
+    for f, frame in enumerate(frames):
+        if list(frame.predictions) != methods:
+            raise ValueError(f"frame {frame.label!r} has methods {list(frame.predictions)}, not {methods}")
+        valid = (np.asarray(frame.gt_m) > 0) if frame.valid is None else np.asarray(frame.valid, bool)
+        cells = outer[f].subgridspec(2, ncols, hspace=0.04, wspace=0.03)
+        top = [_as_rgb(frame.rgb), colorize_sparse(frame.sparse_m, 0.0, max_m, cmap),
+               colorize_depth(np.where(valid, frame.gt_m, 0), 0.0, max_m, cmap)]
+        top += [colorize_depth(pred, 0.0, max_m, cmap) for pred in frame.predictions.values()]
+        for c, (image, title) in enumerate(zip(top, ["RGB", sparse_title, "ground truth"] + methods)):
+            ax = fig.add_subplot(cells[0, c])
+            show(ax, image)
+            if f == 0:
+                ax.set_title(title, fontsize=9)
+        label = fig.add_subplot(cells[1, 0:3])
+        show(label)
+        label.text(0.0, 0.5, "\n".join(textwrap.wrap(frame.label, 40)) + "\n\nbelow each prediction: its error",
+                   fontsize=8, va="center", transform=label.transAxes)
+        for c, pred in enumerate(frame.predictions.values()):
+            ax = fig.add_subplot(cells[1, 3 + c])
+            show(ax, error_map(pred, frame.gt_m, valid, max_error_m))
+            keep = valid & np.isfinite(pred)
+            rmse = float(np.sqrt(np.mean((np.asarray(pred)[keep] - np.asarray(frame.gt_m)[keep]) ** 2)))
+            ax.text(0.03, 0.05, f"RMSE {rmse:.3f} m", fontsize=7, transform=ax.transAxes,
+                    bbox={"facecolor": "white", "alpha": 0.8, "pad": 1.5, "linewidth": 0})
+    bars = outer[len(frames)].subgridspec(1, ncols, wspace=0.03)
+    left = max(1, (ncols - 1) // 2)  # the depth bar's columns; the error bar takes as many at the right
+    for cols, label, vmax, bar_cmap in ((slice(0, left), "depth [m]", max_m, cmap),
+                                        (slice(ncols - left, ncols), "|error| [m]", max_error_m, DEFAULT_ERROR_CMAP)):
+        cax = fig.add_subplot(bars[0, cols])
+        bar = fig.colorbar(ScalarMappable(Normalize(0.0, vmax), bar_cmap), cax=cax, orientation="horizontal")
+        bar.set_label(label, fontsize=8)
+        bar.ax.tick_params(labelsize=7)
     fig.savefig(os.fspath(path), bbox_inches="tight")

@@ -3,6 +3,7 @@ and every user error is one line "lipjax: error: ..." with exit status 1 and no 
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -16,6 +17,7 @@ import lipjax.methods
 from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
+from lipjax.uncertainty import mask_unsupported
 
 H, W = 24, 32
 SCALE = 256.0
@@ -212,7 +214,8 @@ def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_
                    "--ply", str(tmp_path / "a.ply"), "-q"])
     assert rc == 0
     sparse, _ = project_sweep(tmp_path / "sweep.npy", calib, (40, 120))
-    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), model[1](rgb, sparse), rtol=1e-6)
+    expected = mask_unsupported(model[1](rgb, sparse), sparse)  # 0 above the scan: lipjax complete's default
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-6)
     np.save(tmp_path / "sparse.npy", sparse)
     for ply, intrinsics in (("b.ply", ["--intrinsics", str(FX), str(FY), str(CX), str(CY)]),
                             ("c.ply", ["--intrinsics-file", str(calib)])):
@@ -241,6 +244,26 @@ def test_the_default_model_is_named_with_its_reason_and_depth_scale_on_npy_warns
     assert capsys.readouterr().err == ""
 
 
+def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsys):
+    """The tiny model's range is 10 m; samples at 20-40 m would make a solid-red picture, so the colours span
+    0 .. the output's 99th percentile, and the summary line says so; --color-range still wins."""
+    rgb, sparse = _frame(seed=4)
+    rgb_path, npy = _write_frame(tmp_path, rgb, sparse * 8, depth_name="far.npy")
+    out = tmp_path / "o.color.png"
+    args = ["complete", "--rgb", rgb_path, "--depth", npy, "--model", model[0], "--out", str(out)]
+    assert cli.main(args) == 0
+    with pytest.warns(UserWarning, match="beyond the 10 m range"):
+        dense = mask_unsupported(model[1](rgb, sparse * 8), sparse * 8)
+    top = np.percentile(dense[dense > 0], 99)
+    assert 20 < top < 40 and model[1].config.max_depth_m == 10
+    np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, top))
+    err = capsys.readouterr().err.splitlines()
+    assert err[0].startswith("lipjax: warning: sparse depth beyond the 10 m range of the indoor model")
+    assert err[1:] == [f"wrote {out}: colours 0-{top:.3g} m"]
+    assert cli.main(args + ["--color-range", "0", "10", "-q"]) == 0
+    np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, 10))
+
+
 def test_usage_error_returns_2_with_one_line(capsys):
     assert cli.main(["complete", "--rgb", "a.png"]) == 2
     err = capsys.readouterr().err
@@ -251,6 +274,17 @@ def _one_error_line(err, prog="lipjax"):
     lines = [line for line in err.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith(f"{prog}") and "Traceback" not in err, err
     return lines[0]
+
+
+@pytest.mark.parametrize("command", [[], ["complete"], ["project"], ["evaluate"], ["export"], ["models"], ["train"],
+                                     ["data"], ["data", "render"]])
+def test_help_pages_speak_to_users_not_developers(command, capsys):
+    """No function or module names of the code (`_cmd_*`, build_parser, lipjax.<module>) in any --help page."""
+    assert cli.main(command + ["--help"]) == 0
+    page = capsys.readouterr().out
+    assert page.startswith("usage: lipjax") and re.search(r"_cmd_|build_parser|lipjax\.[a-z]", page) is None, page
+    if not command:  # the overview names every command and points to their pages
+        assert "Run `lipjax COMMAND --help` for a command's options." in page and "--rgb     colour" not in page
 
 
 def test_version(capsys):
@@ -287,8 +321,54 @@ def test_evaluate_lidar_sampler_on_a_folder_without_intrinsics_asks_for_them(tmp
     rc = cli.main(["evaluate", "--method", "nearest", "--data", str(tmp_path / "data"), "--sampler", "lidar:hdl64",
                    "--max-depth-m", "10", "--quiet"])
     line = _one_error_line(capsys.readouterr().err)
-    assert rc == 1 and "lidar:hdl64 simulates a LiDAR and needs the camera intrinsics" in line
+    assert rc == 1 and "sampler 'lidar:hdl64' simulates a LiDAR and needs the camera intrinsics" in line
     assert "--intrinsics fx fy cx cy" in line and "intrinsics.txt" in line
+
+
+def _own_data_folder(root, frames=10, names=("", "", "")):
+    """rgb/ depth/ sparse/ .npy frames, no intrinsics: ground truth 2 + i / 10 m everywhere, the sparse maps hold
+    it plus 1 m at 12 pixels, so a nearest fill of sparse/ is 1 m off everywhere (and 0 m off from GT samples).
+    names: the stems' prefixes in rgb/, depth/, sparse/ (frames then pair by number)."""
+    for sub in ("rgb", "depth", "sparse"):
+        (root / sub).mkdir(parents=True)
+    for i in range(frames):
+        rgb, sparse = _frame(seed=i, h=12, w=16)
+        depth = np.full((12, 16), 2 + i / 10, np.float32)
+        cv2.imwrite(str(root / "rgb" / f"{names[0]}{i:03d}.png"), rgb[..., ::-1])
+        np.save(root / "depth" / f"{names[1]}{i:03d}.npy", depth)
+        np.save(root / "sparse" / f"{names[2]}{i:03d}.npy",
+                np.where(np.arange(192).reshape(12, 16) % 16 == 5, depth + 1, 0))
+
+
+def test_evaluate_own_folder_scores_its_sparse_maps_on_every_frame_without_intrinsics(tmp_path, capsys):
+    _own_data_folder(tmp_path / "mine")
+    args = ["evaluate", "--method", "nearest", "--data", str(tmp_path / "mine"), "--max-depth-m", "10", "--quiet",
+            "--columns", "rmse_m", "--json", str(tmp_path / "r.json")]
+    assert cli.main(args) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == (f"data: {tmp_path / 'mine'}, every frame (10 frames), sampler: input (the data's own sparse "
+                      "maps), depth range: (0, 10] m")
+    result = json.loads((tmp_path / "r.json").read_text())["nearest"]
+    assert result["num_images"] == 10 and result["metrics"]["rmse_m"] == pytest.approx(1.0, abs=1e-5)
+    assert cli.main(args + ["--split", "val"]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == (
+        f"data: {tmp_path / 'mine'}, val split: the last 5 % of the frames, as lipjax train holds them out (1 frames), "
+        "sampler: input (the data's own sparse maps), depth range: (0, 10] m")
+    assert cli.main(args + ["--sampler", "uniform:20"]) == 0  # samples of the ground truth: exact
+    assert json.loads((tmp_path / "r.json").read_text())["nearest"]["metrics"]["rmse_m"] == pytest.approx(0, abs=1e-6)
+    capsys.readouterr()
+    assert cli.main(["evaluate", "--method", "nearest", "--source", "folder", "--root", str(tmp_path / "mine"),
+                     "--sampler", "input", "--max-depth-m", "10", "--quiet", "--columns", "rmse_m"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].startswith(f"data: folder val ({tmp_path / 'mine'}) (1 frames)")
+
+
+def test_evaluate_own_folder_pairs_sparse_maps_by_number_as_it_pairs_depth(tmp_path, capsys):
+    """NYU/BTS-style names (rgb_000.png, sync_depth_000.npy): the sparse maps pair with the frames by number too."""
+    _own_data_folder(tmp_path / "mine", frames=3, names=("rgb_", "sync_depth_", "sync_depth_"))
+    assert cli.main(["evaluate", "--method", "nearest", "--data", str(tmp_path / "mine"), "--max-depth-m", "10",
+                     "--quiet", "--json", str(tmp_path / "r.json")]) == 0
+    assert "every frame (3 frames), sampler: input (the data's own sparse maps)" in capsys.readouterr().out
+    assert json.loads((tmp_path / "r.json").read_text())["nearest"]["metrics"]["rmse_m"] == pytest.approx(1.0)
 
 
 def test_subprocess_error_has_no_traceback(tmp_path):
@@ -305,15 +385,26 @@ def test_subprocess_error_has_no_traceback(tmp_path):
     assert result.stderr.startswith("lipjax: error: ") and "Traceback" not in result.stderr, result.stderr
 
 
-def test_models_command_says_what_each_model_is(capsys):
+def test_models_command_is_a_table_in_aligned_columns_marking_every_default(capsys):
+    from lipjax.inputs import DEFAULT_MODELS
+
     assert cli.main(["models"]) == 0
-    out = capsys.readouterr().out
-    assert all(name in out for name in lipjax.available_models()) and out.strip()
-    assert "None" not in out
-    for line in out.splitlines():
-        assert ("LIP, " in line and " iterations, " in line) or "network (end to end)" in line, line
-        assert " max depth " in line and line.split(" max depth ")[1].split()[0].replace(".", "").isdigit(), line
-        assert " trained on " in line and line.endswith(" images"), line  # every shipped model states its budget
+    lines = capsys.readouterr().out.splitlines()
+    header, rows = lines[0], lines[1:1 + len(lipjax.available_models())]
+    assert header.split() == ["MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL", "RMSE", "VALIDATED", "ON",
+                              "TRAINED", "ON"]
+    starts = [header.index(c) for c in model_io.TABLE_COLUMNS] + [None]
+    cells = [[row[a:b].strip() for a, b in zip(starts, starts[1:])] for row in rows]
+    for row, cell in zip(rows, cells):  # every cell starts at its column: no text runs across a column edge
+        assert all(row[a - 1] == " " for a in starts[1:-1] if a < len(row)), row
+    assert [c[0] for c in cells] == lipjax.available_models() and "None" not in "".join(rows)
+    defaults = {c[0]: c[1] for c in cells if c[1]}
+    marks = {name: ", ".join(s for s, m in DEFAULT_MODELS.items() if m == name) for name in DEFAULT_MODELS.values()}
+    assert defaults == marks  # each default marked with its scene(s), and only they
+    for c in cells:
+        assert c[2].startswith("LIP, ") and c[3].isdigit() or c[3] == c[4] == "-", c
+        assert c[5] in ("10 m", "85 m") and c[6].endswith(" m") and c[8].endswith(" images"), c
+    assert max(len(line) for line in lines) < 120
 
 
 def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):

@@ -25,6 +25,24 @@ def test_nyu_200pts_smoke_writes_results_table_and_figure(tmp_path, capsys):
     assert (tmp_path / "figure.png").stat().st_size > 1000
 
 
+def test_figures_show_the_three_best_methods_and_the_best_without_learned_weights():
+    from experiments.common import key_methods
+    from lipjax.evaluate import EvalResult
+    from lipjax.inference import Completer
+
+    def result(rmse):
+        return EvalResult("m", {"rmse_m": rmse}, {}, [], 0.0, 0.0, 1, 0.0, 10.0)
+
+    learned = Completer(LIPConfig(), None)
+    rmse = {"a": 0.2, "b": 0.1, "linear": 0.5, "c": 0.15, "d": 0.3, "nearest": 0.6}
+    completers = {m: "fill" if m in ("linear", "nearest") else learned for m in rmse}
+    assert key_methods({m: result(r) for m, r in rmse.items()}, completers) == ["a", "b", "linear", "c"]
+    rmse["linear"] = 0.05  # among the best three already: the fourth best joins
+    assert key_methods({m: result(r) for m, r in rmse.items()}, completers) == ["a", "b", "linear", "c"]
+    rmse["c"] = 0.35
+    assert key_methods({m: result(r) for m, r in rmse.items()}, completers) == ["a", "b", "linear", "d"]
+
+
 def test_kitti_dc_smoke(tmp_path):
     kitti_dc.main(["--variant", "smoke", "--out", str(tmp_path)])
     doc = json.loads((tmp_path / "results.json").read_text())

@@ -10,8 +10,12 @@ from __future__ import annotations
 import dataclasses
 import importlib.util
 import json
+import os
+import pathlib
+import signal
 import subprocess
 import sys
+import time
 
 import cv2
 import h5py
@@ -332,18 +336,55 @@ def test_lipjax_evaluate_reads_a_source_as_training_does(tmp_path, capsys):
 
 
 def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
-    """`lipjax train --data DIR` (= lip_cnn_folder: fine-tunes the shipped lip-cnn-indoor), then `lipjax complete`."""
+    """`lipjax train --data DIR --init lip-cnn-indoor` (= lip_cnn_folder), then `lipjax complete`."""
     root = make_folder(tmp_path / "folder")
     model = tmp_path / "model"
     train = subprocess.run([sys.executable, "-m", "lipjax.cli", "train", "--data", str(root), "--out", str(model),
                             "--depth-scale", "1000", "--steps", "2", "--batch-size", "2", "--crop", "24", "32",
-                            "--workers", "0",
+                            "--workers", "0", "--init", "lip-cnn-indoor",
                             "--workdir", str(tmp_path / "run"), "--quiet"], capture_output=True, text=True, timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
                     "--depth-scale", "1000")
     assert done.returncode == 0, done.stderr[-3000:]
     assert np.load(tmp_path / "out.npy").shape == (H, W)
+
+
+def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_and_validates_at_0_and_the_end(
+        tmp_path, capsys, monkeypatch):
+    """Without --init, `lipjax train` fine-tunes the default model of the frames' scene (lipjax.inputs.DEFAULT_MODELS,
+    here a tiny stand-in) and says so in one line; no intrinsics are needed for point samplers; the validation score
+    of the starting model (step 0) and of the result are printed and logged; the model and the run are named after
+    --out."""
+    import lipjax.inputs
+    from lipjax import cli, model_io
+    from lipjax.train.folder import default_init, folder_config
+    from lipjax.train.run import logged_validation
+
+    stem = tmp_path / "tiny"
+    model_io.save(stem, CONFIG.model, init_state(CONFIG).g_params)
+    monkeypatch.setitem(lipjax.inputs.DEFAULT_MODELS, "indoor", str(stem))
+    root = make_folder(tmp_path / "folder")
+    (root / "intrinsics.txt").unlink()
+    out = tmp_path / "models" / "mine"
+    assert cli.main(["train", "--data", str(root), "--out", str(out), "--depth-scale", "1000", "--steps", "2",
+                     "--batch-size", "2", "--crop", "24", "32", "--workers", "0",
+                     "--workdir", str(tmp_path / "run")]) == 0
+    captured = capsys.readouterr()
+    init, scene, why = default_init(root=str(root), depth_scale=1000.0)
+    assert (init, scene) == (str(stem), "indoor")
+    assert captured.err.splitlines()[0] == f"init: {stem}, the default for indoor input ({why}); choose another with " \
+                                           "--init"
+    start, end = (logged_validation(tmp_path / "run" / "metrics.jsonl", step) for step in (0, 2))
+    config = folder_config(CONFIG.model, str(stem), root=str(root), depth_scale=1000.0, crop=CROP, num_workers=0)
+    want = loop.evaluate_params(CONFIG.model, model_io.load(stem)[1], loop.validation_batches(config), 10.0)
+    assert start["rmse_m"] == pytest.approx(want["rmse_m"], rel=1e-6)
+    lines = captured.out.splitlines()
+    assert f"[lipjax] step 0 (start) val rmse_m={start['rmse_m']:.4f} mae_m={start['mae_m']:.4f}" in lines
+    assert lines[-1] == (f"[lipjax] exported mine (step 2) to {out}: val rmse_m={end['rmse_m']:.4f} "
+                         f"({start['rmse_m']:.4f} at step 0)")
+    meta = model_io.metadata(out)
+    assert meta["train_config"] == "mine" and meta["val_metrics"]["rmse_m"] == end["rmse_m"]
 
 
 def test_lipjax_train_checks_its_output_folder_and_every_frame_before_training(tmp_path, capsys):
@@ -382,6 +423,61 @@ def test_lipjax_data_render_command(tmp_path, capsys):
     assert cli.main(args) == 0 and len(RenderedDataset(tmp_path / "r")) == 2
     assert cli.main(args[:5] + ["3"] + args[6:]) == 1  # another render into the same folder: a one-line error
     assert "already holds a different render" in capsys.readouterr().err
+
+
+# `lipjax data render` with 4-frame shards, so that a short render has many shards to stop between.
+RENDER_IN_SHARDS_OF_4 = ("import functools, sys; import lipjax.data.rendered as r; "
+                         "r.render_to_disk = functools.partial(r.render_to_disk, shard_size=4); "
+                         "from lipjax.cli import main; sys.exit(main(sys.argv[1:]))")
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT, signal.SIGKILL])
+def test_a_stopped_render_takes_its_workers_with_it_and_the_same_command_finishes_it(tmp_path, signum):
+    """SIGTERM, Ctrl-C (SIGINT to the whole process group, as a terminal sends it) or SIGKILL in the middle of
+    `lipjax data render --workers 2`: no worker outlives the command, which says in one line how to finish
+    (exit 143 / 130); the finished shards stay as they were, and the same render finishes the set, bit for bit
+    what an uninterrupted render writes."""
+    from lipjax.data.rendered import RenderSpec, _render_shard
+    from test_train import _alive, _children
+
+    out, count = tmp_path / "r", 120
+    args = ["data", "render", "--kind", "indoor", "--count", str(count), "--height", "256", "--width", "320",
+            "--workers", "2", "--out", str(out), "--quiet"]
+    with open(tmp_path / "err.txt", "w") as err:
+        proc = subprocess.Popen([sys.executable, "-c", RENDER_IN_SHARDS_OF_4, *args], stderr=err,
+                                start_new_session=True)
+    try:
+        deadline = time.time() + 120
+        while not list(out.glob("shard-*.depth.npy")) and time.time() < deadline:
+            time.sleep(0.05)
+        workers = _children(proc.pid)
+        assert len(workers) >= 2  # the two workers (and multiprocessing's resource tracker)
+        if signum == signal.SIGINT:
+            os.killpg(proc.pid, signum)
+        else:
+            proc.send_signal(signum)
+        assert proc.wait(timeout=60) == {signal.SIGTERM: 143, signal.SIGINT: 130, signal.SIGKILL: -9}[signum]
+    finally:
+        proc.kill()
+    deadline = time.time() + 20
+    while [w for w in workers if _alive(w)] and time.time() < deadline:
+        time.sleep(0.1)
+    assert not [w for w in workers if _alive(w)], "render processes outlived the command"
+    if signum != signal.SIGKILL:
+        assert (tmp_path / "err.txt").read_text() == (f"lipjax: render stopped; its finished shards stay in {out}, "
+                                                      "and the same command finishes it\n")
+    finished = {p.name: p.read_bytes() for p in out.glob("shard-*.npy")}
+    assert 0 < len(finished) < 2 * count // 4 and not (out / "index.json").exists()
+    render_to_disk("indoor", "train", count, out, height=256, width=320, workers=1, shard_size=4, progress=False)
+    assert len(RenderedDataset(out)) == count and not list(out.glob(".shard-*"))
+    assert all((out / name).read_bytes() == data for name, data in finished.items())
+    spec = RenderSpec("indoor", "train", count, 256, 320, None, 4)
+    for shard in (0, spec.num_shards - 1):
+        _render_shard(spec, shard, str(tmp_path))
+        for part in ("rgb", "depth"):
+            name = f"shard-{shard:05d}.{part}.npy"
+            assert (out / name).read_bytes() == (tmp_path / name).read_bytes(), name
 
 
 def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, capsys):

@@ -255,13 +255,14 @@ def _children(pid: int) -> set[int]:
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
     """A killed run (SIGTERM) saves the step it was in, although no checkpoint was due, exits with 143 and takes
-    its loader worker process with it; the checkpoint restores at that step, with its data position."""
+    its loader worker processes with it, leaving no shared memory behind; the checkpoint restores at that step,
+    with its data position."""
     workdir = tmp_path / "run"
     cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
-           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=100000",
+           "--set", "g_steps=100000", "--set", "data.num_workers=2", "--set", "checkpoint_every=100000",
            "--set", "log_every=1", "--set", "eval_every=0"]
-    proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL)
+    with open(tmp_path / "out.txt", "w") as out:
+        proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT)
     metrics = workdir / "metrics.jsonl"
     try:
         deadline = time.time() + 240
@@ -280,6 +281,8 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
     while [w for w in workers if _alive(w)] and time.time() < deadline:
         time.sleep(0.2)
     assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
+    text = (tmp_path / "out.txt").read_text()
+    assert "leaked shared_memory" not in text and "Traceback" not in text, text[-3000:]
     from experiments.configs import get_config
 
     manager = CheckpointManager(workdir / "checkpoints")
@@ -291,10 +294,11 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 def test_ctrl_c_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
     """Ctrl-C as a terminal sends it (SIGINT to the whole process group, loader workers included) saves the step
-    in progress, although no checkpoint was due, says so, exits with 130, and the workers end with the run."""
+    in progress, although no checkpoint was due, says so, exits with 130, and the workers end with the run,
+    leaving no shared memory behind."""
     workdir = tmp_path / "run"
     cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
-           "--set", "g_steps=100000", "--set", "data.num_workers=1", "--set", "checkpoint_every=100000",
+           "--set", "g_steps=100000", "--set", "data.num_workers=2", "--set", "checkpoint_every=100000",
            "--set", "log_every=1", "--set", "eval_every=0"]
     with open(tmp_path / "out.txt", "w") as out:
         proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT,
@@ -316,7 +320,7 @@ def test_ctrl_c_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pat
     text = (tmp_path / "out.txt").read_text()
     said = f"[lipjax] SIGINT: saved step {saved[0]} in {workdir / 'checkpoints'}; stopping (run again to resume)"
     assert said in text
-    assert "Traceback" not in text, text[-3000:]
+    assert "Traceback" not in text and "leaked shared_memory" not in text, text[-3000:]
     deadline = time.time() + 20
     while [w for w in workers if _alive(w)] and time.time() < deadline:
         time.sleep(0.2)

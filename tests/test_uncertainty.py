@@ -120,17 +120,34 @@ def _cli(args):
     return cli.main(["complete", "--quiet"] + [str(a) for a in args])
 
 
-def test_cli_writes_the_expected_error_in_metres(tmp_path):
+def test_cli_writes_the_expected_error_in_metres_and_zero_depth_without_support(tmp_path, capsys):
+    """By default the depth output and the PLY are 0 where no sample supports them (support_mask: here the rows
+    more than one spacing above the top scan line), and the summary line says how much; --fill-all writes the
+    dense map; the uncertainty file keeps every pixel either way."""
     import lipjax
+    from lipjax import cli
 
     rgb, sparse, args = _cli_frame(tmp_path / "in")
-    assert _cli(args + ["--out", tmp_path / "d.npy", "--uncertainty", tmp_path / "u.npy"]) == 0
+    ply = ["--ply", tmp_path / "c.ply", "--intrinsics", 40, 40, 23.5, 17.5]
+    assert cli.main(["complete"] + [str(a) for a in args + ["--out", tmp_path / "d.npy", "--uncertainty",
+                                                              tmp_path / "u.npy"] + ply]) == 0
     dense = lipjax.complete(rgb, sparse, model="linear")
+    support = uncertainty.support_mask(sparse)
     u = np.load(tmp_path / "u.npy")
     assert u.dtype == np.float32 and u.shape == sparse.shape
-    np.testing.assert_allclose(u, expected_error(sparse, dense), rtol=1e-6)
-    np.testing.assert_allclose(np.load(tmp_path / "d.npy"), dense, rtol=1e-6)  # no threshold: depth unchanged
+    np.testing.assert_allclose(u, expected_error(sparse, dense), rtol=1e-6)  # of the dense map, every pixel
     assert u[:10].min() >= u[16:].max() and (u[sparse > 0] == 0).all()
+    out = np.load(tmp_path / "d.npy")
+    np.testing.assert_allclose(out, np.where(support, dense, 0.0), rtol=1e-6)
+    assert (out[:15] == 0).all() and (out[15:] > 0).all() and (dense > 0).all()  # s = 1.9 px: rows 0-14 go
+    header = (tmp_path / "c.ply").read_bytes().split(b"end_header\n")[0].decode()
+    assert f"element vertex {int(support.sum())}" in header
+    share = 100 * (~support).sum() / support.size
+    assert capsys.readouterr().err == (f"wrote {tmp_path / 'd.npy'} and {tmp_path / 'c.ply'}: {share:.1f} % of the "
+                                       "pixels without support set to 0 (--fill-all keeps them)\n")
+    assert _cli(args + ["--out", tmp_path / "full.npy", "--uncertainty", tmp_path / "u2.npy", "--fill-all"]) == 0
+    np.testing.assert_allclose(np.load(tmp_path / "full.npy"), dense, rtol=1e-6)
+    np.testing.assert_array_equal(np.load(tmp_path / "u2.npy"), u)
 
 
 def test_cli_max_uncertainty_empties_depth_and_ply(tmp_path):
@@ -143,7 +160,7 @@ def test_cli_max_uncertainty_empties_depth_and_ply(tmp_path):
                       "--intrinsics", 40, 40, 23.5, 17.5, "--uncertainty", tmp_path / "u.png"])
     assert rc == 0
     out = np.load(tmp_path / "d.npy")
-    np.testing.assert_allclose(out, np.where(u > limit, 0.0, dense), rtol=1e-6)
+    np.testing.assert_allclose(out, np.where((u > limit) | ~uncertainty.support_mask(sparse), 0.0, dense), rtol=1e-6)
     assert (out[:10] == 0).all() and (out[16:] > 0).all()
     header = (tmp_path / "c.ply").read_bytes().split(b"end_header\n")[0].decode()
     assert f"element vertex {int((out > 0).sum())}" in header
@@ -157,6 +174,8 @@ def test_cli_max_uncertainty_empties_depth_and_ply(tmp_path):
 
 
 def test_cli_uncertainty_folder_gets_one_npy_per_frame(tmp_path):
+    import lipjax
+
     rgb, sparse, _ = _cli_frame(tmp_path / "rgb")
     (tmp_path / "rgb" / "f.npy").rename(tmp_path / "f.npy")
     (tmp_path / "depth").mkdir()
@@ -164,7 +183,9 @@ def test_cli_uncertainty_folder_gets_one_npy_per_frame(tmp_path):
     rc = _cli(["--rgb", tmp_path / "rgb", "--depth", tmp_path / "depth", "--model", "linear", "--out", tmp_path / "o",
                "--uncertainty", tmp_path / "u"])
     assert rc == 0
-    dense = np.load(tmp_path / "o" / "f.npy")
+    dense = lipjax.complete(rgb, sparse, model="linear")
+    np.testing.assert_allclose(np.load(tmp_path / "o" / "f.npy"), uncertainty.mask_unsupported(dense, sparse),
+                               rtol=1e-6)
     np.testing.assert_allclose(np.load(tmp_path / "u" / "f.npy"), expected_error(sparse, dense), rtol=1e-6)
 
 
@@ -176,3 +197,43 @@ def test_cli_uncertainty_errors_are_one_line(tmp_path, capsys, extra, message):
     _, _, args = _cli_frame(tmp_path / "in")
     assert _cli(args + ["--out", tmp_path / "d.npy"] + extra) == 1
     assert capsys.readouterr().err == message
+
+
+def _support_by_hand(sparse):
+    """support_mask's rule computed pixel by pixel: within 1 spacing below the highest sample of the columns
+    within ceil(2 s) either side, and within 3 spacings (Euclidean, pixels) of some sample."""
+    h, w = sparse.shape
+    rows, cols = np.nonzero(sparse > 0)
+    s = max(1.0, math.sqrt((np.ptp(rows) + 1) * (np.ptp(cols) + 1) / rows.size))
+    reach = math.ceil(2 * s)
+    first = [rows[cols == c].min() if (cols == c).any() else h for c in range(w)]
+    out = np.zeros((h, w), bool)
+    for r in range(h):
+        for c in range(w):
+            top = min(first[max(0, c - reach):c + reach + 1])
+            near = np.sqrt((rows - r) ** 2 + (cols - c) ** 2).min()
+            out[r, c] = (top - r) <= s and near <= 3 * s
+    return out
+
+
+def test_support_mask_follows_its_rule_in_pixels():
+    """Scan lines in the lower half with a hole: the rows above the top line and the hole's middle have no support;
+    the mask agrees with an independent pixel-by-pixel computation; mask_unsupported sets exactly those to 0."""
+    sparse = np.zeros((60, 60), np.float32)
+    sparse[20::2, ::2] = 7.0
+    sparse[30:50, 10:50] = 0.0  # a hole in the scan: 20 rows, 40 columns
+    s = uncertainty.sample_spacing(sparse)
+    mask = uncertainty.support_mask(sparse)
+    np.testing.assert_array_equal(mask, _support_by_hand(sparse))
+    assert s == pytest.approx(math.sqrt(39 * 59 / np.count_nonzero(sparse))) and 3 * s == pytest.approx(7.2, abs=0.1)
+    top_kept = 20 - math.floor(s)
+    assert mask[top_kept:, 0].all() and not mask[:top_kept, :].any()  # 1 spacing above the top line, no higher
+    assert not mask[39, 30] and not mask[36, 30] and mask[35, 30]  # 10, 8 and 7 px from the nearest line (row 28)
+    assert mask[sparse > 0].all()
+    depth = np.full(sparse.shape, 9.0, np.float32)
+    masked = uncertainty.mask_unsupported(depth, sparse)
+    np.testing.assert_array_equal(masked, np.where(mask, 9.0, 0.0))
+    np.testing.assert_array_equal(uncertainty.support_mask(np.stack([sparse, sparse]))[1], mask)
+    rng = np.random.default_rng(0)
+    scattered = np.where(rng.random((30, 50)) < 0.03, rng.uniform(1, 5, (30, 50)), 0).astype(np.float32)
+    np.testing.assert_array_equal(uncertainty.support_mask(scattered), _support_by_hand(scattered))

@@ -1,4 +1,6 @@
 """Depth and error colour maps use fixed ranges; panels tile images; figures are written."""
+import dataclasses
+
 import cv2
 import matplotlib
 import numpy as np
@@ -47,19 +49,31 @@ def test_colorize_sparse_enlarges_points_nearest_on_top():
     np.testing.assert_array_equal(img[0, 0], 0)
 
 
-def test_comparison_row_and_figure(tmp_path):
+def test_comparison_grid_reads_on_a_laptop_screen(tmp_path):
+    """3 frames x 4 methods (each with its error map) fit a 1400 x 900 screen at 100 %; the error panels are the
+    error maps of their predictions; frames with other methods are an error."""
     rng = np.random.default_rng(0)
-    gt = rng.uniform(1, 9, (16, 20)).astype(np.float32)
-    sparse = np.where(rng.random((16, 20)) < 0.05, gt, 0).astype(np.float32)
-    rgb = rng.integers(0, 256, (16, 20, 3), dtype=np.uint8)
-    row = viz.comparison_row(rgb, sparse, gt, None, {"A": gt + 0.1, "B": gt}, max_m=10, max_error_m=0.5)
-    titles = viz.comparison_titles(["A", "B"])
-    assert len(row) == len(titles) == 7 and all(im.shape == (16, 20, 3) for im in row)
-    viz.write_png(tmp_path / "rgb.png", row[0])
-    np.testing.assert_array_equal(cv2.imread(str(tmp_path / "rgb.png"))[..., ::-1], rgb)  # written as RGB
-    with pytest.raises(ValueError, match="uint8"):
-        viz.save_panel(tmp_path / "bad.png", [[gt]])
-    viz.save_panel(tmp_path / "fig.png", [row, row], titles, row_labels=["1", "2"],
-                   colorbars=[("depth [m]", 0, 10, "turbo"), ("error [m]", 0, 0.5, "jet")])
-    fig = cv2.imread(str(tmp_path / "fig.png"))
-    assert fig is not None and fig.shape[1] > fig.shape[0]
+    frames = []
+    for i in range(3):
+        gt = rng.uniform(1, 9, (32, 40)).astype(np.float32)  # the 4:5 aspect of 256x320
+        sparse = np.where(rng.random(gt.shape) < 0.05, gt, 0).astype(np.float32)
+        rgb = rng.integers(0, 256, (32, 40, 3), dtype=np.uint8)
+        predictions = {name: gt + offset for name, offset in (("A", 0.0), ("B", 0.1), ("C", 0.2), ("linear", 0.4))}
+        frames.append(viz.Comparison(f"synthetic/indoor/test/{i:06d}", rgb, sparse, gt, predictions))
+    viz.save_comparison_grid(tmp_path / "fig.png", frames, max_m=10, max_error_m=0.5)
+    height, width = cv2.imread(str(tmp_path / "fig.png")).shape[:2]
+    assert 700 < width <= 1400 and 600 < height <= 900, (width, height)
+    frames[1] = dataclasses.replace(frames[1], predictions={"A": frames[1].gt_m})
+    with pytest.raises(ValueError, match="has methods \\['A'\\], not \\['A', 'B', 'C', 'linear'\\]"):
+        viz.save_comparison_grid(tmp_path / "bad.png", frames, max_m=10, max_error_m=0.5)
+
+
+def test_fitting_range_is_the_models_unless_the_data_do_not_fit():
+    rng = np.random.default_rng(0)
+    indoor = rng.uniform(1, 8, (20, 30))
+    assert viz.fitting_range(indoor, 10.0) == (0.0, 10.0)                     # fits: the fixed range
+    street = np.concatenate([rng.uniform(5, 60, 990), np.full(10, 500.0), [0.0, np.nan, np.inf]])
+    assert viz.fitting_range(street, 10.0) == (0.0, pytest.approx(np.percentile(street[:1000], 99)))
+    assert viz.fitting_range(street, 10.0)[1] < 500                         # the 1 % outliers do not set it
+    assert viz.fitting_range(indoor, 85.0) == (0.0, pytest.approx(np.percentile(indoor, 99)))  # under 85 / 4
+    assert viz.fitting_range(np.zeros((4, 4)), 10.0) == (0.0, 10.0)

@@ -41,6 +41,8 @@ FOLDER_LAYOUT = """\
 FOLDER_SOURCE = "your own frames (lipjax.data.folder.FolderDataset)"
 
 _DIGITS = re.compile(r"(\d+)")
+# Stands in for the intrinsics of a folder without any, where nothing reads them (FolderDataset).
+UNUSED_INTRINSICS = Intrinsics(1.0, 1.0, 0.0, 0.0)
 
 
 def natural_key(text: str) -> tuple:
@@ -232,6 +234,12 @@ def _trailing_number(stem: str) -> str | None:
     return match.group(1) if match else None
 
 
+def files_by_number(directory: Path, suffixes: tuple[str, ...] = DEPTH_SUFFIXES) -> dict[str, Path]:
+    """The files of `directory` with one of `suffixes`, keyed by the number their stems end with, as frames pair
+    by number (rgb_00050.jpg, sync_depth_00050.png: "00050"); stems that end in none are left out."""
+    return {n: p for stem, p in _list(Path(directory), suffixes).items() if (n := _trailing_number(stem)) is not None}
+
+
 def pair_frames(rgb_dir: Path, depth_dir: Path) -> list[tuple[str, Path, Path]]:
     """(key, rgb path, depth path) of every frame, in natural order. Frames pair by file stem; when no stem
     matches, by the number the stem ends with. An RGB image without depth (or the reverse) is an error."""
@@ -274,10 +282,13 @@ class FolderDataset:
       depth_scale: raw PNG value per metre (required when any depth file is a PNG).
       intrinsics: overrides intrinsics files; otherwise root/intrinsics.txt, else root/intrinsics/<stem>.txt.
       id_prefix: Sample.id = f"{id_prefix}/{stem}"; defaults to "folder/<root name>".
+      intrinsics_needed: False when nothing reads the intrinsics (only the LiDAR simulation of
+        lipjax.data.sampling does): a folder without them is then no error, and its Samples carry
+        UNUSED_INTRINSICS.
     """
 
     def __init__(self, root: str | os.PathLike, depth_scale: float | None = None,
-                 intrinsics: Intrinsics | None = None, id_prefix: str | None = None):
+                 intrinsics: Intrinsics | None = None, id_prefix: str | None = None, intrinsics_needed: bool = True):
         self.root = Path(root)
         rgb_dir, depth_dir = self.root / "rgb", self.root / "depth"
         for directory in (rgb_dir, depth_dir):
@@ -298,10 +309,10 @@ class FolderDataset:
         if self.intrinsics is None and (self.root / "intrinsics.txt").is_file():
             self.intrinsics = read_intrinsics_txt(self.root / "intrinsics.txt")
         if self.intrinsics is None and not (self.root / "intrinsics").is_dir():
-            raise dataset_error(
-                "No intrinsics: pass intrinsics=..., or write intrinsics.txt (fx fy cx cy) or intrinsics/<stem>.txt in",
-                self.root, FOLDER_LAYOUT,
-            )
+            if intrinsics_needed:
+                raise dataset_error("No intrinsics: pass intrinsics=..., or write intrinsics.txt (fx fy cx cy) or "
+                                    "intrinsics/<stem>.txt in", self.root, FOLDER_LAYOUT)
+            self.intrinsics = UNUSED_INTRINSICS
         self.id_prefix = id_prefix if id_prefix is not None else f"folder/{self.root.resolve().name}"
 
     def __len__(self) -> int:

@@ -247,7 +247,9 @@ class TrainLoader:
             raise RuntimeError(f"the data loader yielded step {step}, expected {self.next_step}; "
                                "remove the checkpoint's data_loader state or start a new workdir")
         self.next_step += 1
-        return Batch(**arrays)
+        # Copied out of the workers' shared memory at once, so that grain unlinks it now, while the loader runs:
+        # a batch still in hand when a signal stops the run would leak its segments ("leaked shared_memory").
+        return Batch(**{k: None if v is None else np.array(v) for k, v in arrays.items()})
 
     def close(self) -> None:
         """Stops the worker processes and frees grain's iterators now (not at interpreter exit, where their

@@ -23,11 +23,15 @@ per frame instead of a new one per epoch. The camera model's vignetting is centr
 """
 from __future__ import annotations
 
-import concurrent.futures
+import contextlib
 import dataclasses
+import functools
 import json
 import multiprocessing
 import os
+import signal
+import sys
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -133,6 +137,30 @@ def _render_shard(spec: RenderSpec, shard: int, out: str) -> int:
     return last - first
 
 
+def _render_worker_init() -> None:
+    """A render worker ignores SIGINT (a terminal's Ctrl-C reaches the whole process group; the parent stops the
+    workers) and, on Linux, gets SIGTERM when its parent dies, even by SIGKILL: no worker outlives the render."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform == "linux":
+        import ctypes
+
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+
+
+@contextlib.contextmanager
+def _sigterm_as_exit():
+    """SIGTERM raises SystemExit(143) in the main thread while rendering (Ctrl-C raises KeyboardInterrupt already),
+    so that the worker processes are stopped on the way out. No-op outside the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def _index(spec: RenderSpec) -> dict:
     from lipjax.data.synthetic import intrinsics_for
 
@@ -156,7 +184,8 @@ def render_to_disk(kind: str, split: str, count: int, out: str | os.PathLike, *,
       window: (h, w) to store one window per frame instead (module docstring); None stores full frames.
       workers: processes (default: every core). Each renders whole shards; the shards are independent.
     Returns the folder. Re-running with the same arguments finishes an interrupted render; different
-    arguments in a folder that holds a render are an error.
+    arguments in a folder that holds a render are an error. SIGTERM (SystemExit 143), Ctrl-C (KeyboardInterrupt)
+    or a failing shard stop every worker process before the exception leaves; finished shards stay.
     """
     from lipjax.data.synthetic import check_kind_split, check_size
 
@@ -176,19 +205,30 @@ def render_to_disk(kind: str, split: str, count: int, out: str | os.PathLike, *,
         if existing.is_file() and json.loads(existing.read_text()) != index:
             raise ValueError(f"{out} already holds a different render ({existing.name}); choose another --out")
     partial.write_text(json.dumps(index, indent=1) + "\n")
+    for stale in out.glob(".shard-*.npy"):  # the half-written shards of a stopped render
+        stale.unlink()
     workers = max(1, min(workers or os.cpu_count() or 1, spec.num_shards))
     from tqdm.auto import tqdm
 
-    with tqdm(total=spec.count, desc=f"render {kind}/{split}", disable=not progress, unit="frame") as bar:
+    bar = tqdm(total=spec.count, desc=f"render {kind}/{split}", disable=not progress, unit="frame")
+    with _sigterm_as_exit(), bar:
         if workers == 1:
             for shard in range(spec.num_shards):
                 bar.update(_render_shard(spec, shard, str(out)))
         else:
             context = multiprocessing.get_context("spawn")  # no inherited threads or jax state
-            with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
-                futures = [pool.submit(_render_shard, spec, shard, str(out)) for shard in range(spec.num_shards)]
-                for future in concurrent.futures.as_completed(futures):
-                    bar.update(future.result())
+            pool = context.Pool(workers, initializer=_render_worker_init)
+            try:
+                for done in pool.imap_unordered(functools.partial(_render_shard, spec, out=str(out)),
+                                                range(spec.num_shards)):
+                    bar.update(done)
+            except BaseException:
+                pool.terminate()
+                raise
+            else:
+                pool.close()
+            finally:
+                pool.join()
     os.replace(partial, out / INDEX)
     return out
 

@@ -22,6 +22,7 @@ Depth in metres throughout; `DataConfig` (lipjax.train.config) names the source,
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 from pathlib import Path
 from typing import Any
@@ -31,7 +32,7 @@ import numpy as np
 from lipjax.data.errors import dataset_error
 from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
-from lipjax.data.sampling import SparseSampler, example_rng, sampler_from_spec, subsample_exact
+from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
 
 SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_selection", "kitti_odometry", "tartanair",
            "folder")
@@ -88,28 +89,45 @@ class FolderInput:
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
         from lipjax.data.folder import read_depth
 
-        stem = sample.id[len(self.id_prefix) + 1:]
-        for suffix in (".png", ".npy"):
-            path = Path(self.directory) / f"{stem}{suffix}"
-            if path.is_file():
-                sparse = read_depth(path, self.depth_scale if suffix == ".png" else None)
-                break
-        else:
-            raise dataset_error(f"No sparse input for frame {stem!r} (sparse_input 'input' needs sparse/<stem>)",
-                                Path(self.directory) / f"{stem}.png")
+        path = self._path(sample.id[len(self.id_prefix) + 1:])
+        sparse = read_depth(path, self.depth_scale if path.suffix.lower() == ".png" else None)
         if sparse.shape != sample.shape:
             raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ", path)
         if self.num_points is not None:
             sparse = subsample_exact(sparse, self.num_points, example_rng(seed, sample.id))
         return sparse
 
+    def _path(self, key: str) -> Path:
+        """sparse/<key>.png|.npy; for frames paired by number (key "00050": rgb_00050.jpg with
+        sync_depth_00050.png), the sparse map whose stem ends in that number."""
+        directory = Path(self.directory)
+        for suffix in (".png", ".npy"):
+            if (directory / f"{key}{suffix}").is_file():
+                return directory / f"{key}{suffix}"
+        if key in self._by_number:
+            return self._by_number[key]
+        raise dataset_error(f"No sparse input for frame {key!r} (sampler 'input' needs sparse/<stem>, named as in "
+                            "rgb/ or depth/)", directory / f"{key}.png")
 
-def _own_points(spec: str) -> int | None:
+    @functools.cached_property
+    def _by_number(self) -> dict[str, Path]:
+        from lipjax.data.folder import files_by_number
+
+        return files_by_number(Path(self.directory)) if Path(self.directory).is_dir() else {}
+
+
+def own_points(spec: str) -> int | None:
     _, _, n = spec.partition(":")
     try:
         return int(n) if n else None
     except ValueError:
         raise ValueError(f"sampler spec {spec!r}: expected 'input' or 'input:N' with an integer N") from None
+
+
+def uses_intrinsics(spec: str) -> bool:
+    """Whether the sparse input of `spec` (a lipjax.data.sampling spec, or "input[:N]") reads the camera
+    intrinsics: only the LiDAR simulation does."""
+    return spec.split(":")[0].strip() != OWN_INPUT and draws_scan_lines(spec)
 
 
 def folder_split_root(root: Path, split: str) -> tuple[Path, bool]:
@@ -177,7 +195,9 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         from lipjax.data.folder import FolderDataset
 
         folder, own_split = folder_split_root(Path(root), split)
-        dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}")
+        spec = data.train_sampler if split == "train" else data.val_sampler
+        dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}",
+                                intrinsics_needed=uses_intrinsics(spec))
         own = FolderInput(os.fspath(folder / "sparse"), data.depth_scale, dataset.id_prefix)
         if own_split:
             return dataset, own
@@ -223,9 +243,9 @@ def open_source(data: Any, split: str, *, render_frames: bool = False) -> Source
         if data.source in ("kitti_dc", "kitti_selection"):
             from lipjax.data.kitti import KittiLidarInput
 
-            sampler = KittiLidarInput(own, protocol, _own_points(spec))
+            sampler = KittiLidarInput(own, protocol, own_points(spec))
         else:
-            sampler = dataclasses.replace(own, num_points=_own_points(spec))
+            sampler = dataclasses.replace(own, num_points=own_points(spec))
     else:
         sampler = sampler_from_spec(spec)
     if protocol is not None:

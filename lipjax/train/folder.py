@@ -1,6 +1,7 @@
 """Fine-tuning a model on your own folder of RGB-D frames: the config behind `lipjax train --data DIR`.
 
-    config = folder_config(model_config, "lip-cnn-indoor", root="my_frames", depth_scale=1000)
+    init, scene, why = default_init(root="my_frames", depth_scale=1000)   # the default model of the frames' scene
+    config = folder_config(model_io.load(init)[0], init, root="my_frames", depth_scale=1000)
     lipjax.train.run.run(config, "runs/my_frames", export="models/my_model")   # check_frames first
 
 Unreadable frames stop a run before it starts (`check_frames`, which run() calls for folder sources) rather than
@@ -8,7 +9,8 @@ being skipped: a skipped frame would change which frames every later batch holds
 the seed and s, so that resume is exact) and would hide a broken copy; one pass reading every file costs a few
 milliseconds a frame, and its error names every bad file at once.
 
-The named config lip_cnn_folder (experiments/configs.py) is folder_config(LIP_CNN_INDOOR's model, "lip-cnn-indoor").
+`lipjax train --data DIR` starts from `default_init`; the named config lip_cnn_folder (experiments/configs.py) is
+the same run started from lip-cnn-indoor, folder_config(LIP_CNN_INDOOR's model, "lip-cnn-indoor").
 """
 from __future__ import annotations
 
@@ -41,20 +43,35 @@ def folder_config(model, init_from: str | None, *, name: str = "lip-cnn-folder",
     )
 
 
+def default_init(**data) -> tuple[str, str, str]:
+    """The model `lipjax train` fine-tunes by default: the shipped default model (lipjax.inputs.DEFAULT_MODELS) of
+    the scene that the first training frame's input suggests (lipjax.inputs.scene_reason), as `lipjax complete`
+    picks it. data: DataConfig fields over FOLDER_DATA, as folder_config takes them.
+
+    Returns (model name, scene, the evidence in words)."""
+    from lipjax.data.sources import open_source
+    from lipjax.inputs import DEFAULT_MODELS, scene_reason
+
+    source = open_source(dataclasses.replace(FOLDER_DATA, **data), "train")
+    scene, why = scene_reason(source.sampler(source.dataset[0], 0))
+    return DEFAULT_MODELS[scene], scene, why
+
+
 def check_frames(data: DataConfig) -> int:
     """Reads every frame of a folder source once (RGB, depth, intrinsics, sizes; and sparse/ when a sampler is
     "input"), both splits, in threads. Returns the number of frames; raises one DatasetError naming every
     unreadable file (path relative to data.root and the reason), so that a bad file stops the run before
     training rather than at the step that first draws it."""
     from lipjax.data.folder import FolderDataset, read_depth
-    from lipjax.data.sources import folder_split_root
+    from lipjax.data.sources import folder_split_root, uses_intrinsics
 
     root = Path(data.root).resolve()
     folders = {folder_split_root(root, split)[0] for split in ("train", "val")}
     own_input = "input" in f"{data.train_sampler}|{data.val_sampler}"
+    needed = uses_intrinsics(data.train_sampler) or uses_intrinsics(data.val_sampler)
     jobs = []
     for folder in sorted(folders):
-        dataset = FolderDataset(folder, depth_scale=data.depth_scale)
+        dataset = FolderDataset(folder, depth_scale=data.depth_scale, intrinsics_needed=needed)
         jobs += [functools.partial(dataset.__getitem__, i) for i in range(len(dataset))]
         sparse = sorted((folder / "sparse").glob("*.*")) if own_input and (folder / "sparse").is_dir() else []
         jobs += [functools.partial(read_depth, p, data.depth_scale if p.suffix.lower() == ".png" else None)

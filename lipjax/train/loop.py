@@ -204,8 +204,11 @@ def train(
     mesh=None,
     process_index: int | None = None,
     process_count: int | None = None,
+    validate_start: bool = False,
 ) -> TrainState:
     """Trains (or resumes) a run in `workdir` until config.total_steps (or `stop_at`, to split a run in parts).
+    validate_start: also validate (and log) the starting parameters at step 0 of a new run, the score that
+    fine-tuning is to improve on.
 
     Data-parallel over all devices of `mesh` (default: every device): batches are sharded over the 'data' axis
     and the state is replicated. Multi-host: call jax.distributed.initialize() first in every process; each
@@ -230,6 +233,12 @@ def train(
     loader = _train_loader(config, start, meta, process_index, process_count)
     shown = _Progress(config, workdir, start, end, progress, is_main)
     step = start
+    if val and validate_start and start == 0:
+        vm = evaluate_params(config.model, state.g_params, val, max_depth)
+        if log:
+            log.write(json.dumps({"step": 0, "split": "val", **vm}) + "\n")
+            log.flush()
+            bar.write(f"[lipjax] step 0 (start) val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
     try:
         with _signals_as_exit(save_first=process_count == 1) as stop, loader:
             for step in range(start, end):

@@ -81,14 +81,15 @@ def check_writable(folder: str | os.PathLike, what: str) -> None:
 
 
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
-        export_only: bool = False, average: int = 1, progress: bool = True) -> dict:
+        export_only: bool = False, average: int = 1, progress: bool = True, validate_start: bool = False) -> dict:
     """Trains `config` in `workdir` (resuming), then validates and, when `export` is a path, saves the model there.
     Before training, the folder of `export` must be writable (`check_writable`) and a folder source's frames
     readable (lipjax.train.folder.check_frames).
 
     export_only: skip training and export the latest checkpoint. average: validate and export the mean
     parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
-    metadata as `checkpoints`). Returns the validation metrics (metres).
+    metadata as `checkpoints`). validate_start: validate the starting parameters too (lipjax.train.loop.train);
+    the last line then gives both scores. Returns the validation metrics (metres).
     """
     workdir = pathlib.Path(workdir)
     if average < 1:
@@ -105,7 +106,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         state, _ = manager.restore(init_state(config, init))
         manager.close()
     else:
-        state = train(config, workdir, progress=progress)
+        state = train(config, workdir, progress=progress, validate_start=validate_start)
     averaged = {}
     if average > 1:
         params, steps = averaged_params(config, workdir, jax.device_get(state), average)
@@ -117,14 +118,16 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
     if (workdir / "metrics.jsonl").exists():
         plot_curves(workdir / "metrics.jsonl", workdir / "curves.png", title=config.name)
+    start = logged_validation(workdir / "metrics.jsonl", 0)
+    before = f" ({start['rmse_m']:.4f} at step 0)" if start and int(state.step) > 0 else ""
     if export is not None:
         d = config.data
         export_model(config, state, export, {"val_metrics": val, "val_sampler": d.val_sampler,
                                              "val_images": d.val_images, "data": d.kind if d.source == "synthetic"
                                              else d.source, **averaged})
         what = f"mean of steps {averaged['checkpoints']}" if averaged else f"step {int(state.step)}"
-        print(f"[lipjax] exported {config.name} ({what}) to {export}: val rmse_m={val['rmse_m']:.4f}")
+        print(f"[lipjax] exported {config.name} ({what}) to {export}: val rmse_m={val['rmse_m']:.4f}{before}")
     else:
-        print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f} "
+        print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f}{before} "
               "(nothing exported; add --export PATH)")
     return val
