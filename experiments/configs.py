@@ -128,7 +128,7 @@ BASELINE_CONFIGS: dict[str, TrainConfig] = {
 
 # Scattered points plus LiDAR scan lines on the rooms (a 64-beam and a 16-beam pattern at 0.4 deg azimuth steps,
 # about 7,800 and 2,200 points on a 256x320 room): real sensors give either, and a prox trained on scan lines as
-# well beats linear interpolation on more real frames (README: Design notes, "Scan lines on rooms").
+# well beats linear interpolation on more real frames (docs/design-notes.md, "Scan lines on rooms").
 FAST_INDOOR_SAMPLER = INDOOR_DATA.train_sampler + "|lidar:hdl64,azimuth_step_deg=0.4|lidar:vlp16,azimuth_step_deg=0.4"
 # The shared-encoder prox (lipjax.priors.guided): a third of the paper-style G's FLOPs per frame and ~2.7x its
 # train-step rate here, so it trains longer for the same CPU time. Started from the linear fill (identity-

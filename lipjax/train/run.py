@@ -50,7 +50,7 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
     """Checkpoint averaging: the element-wise mean of G's parameters over the newest `count` checkpoints of the
     run in `workdir` (restored into `template`, a TrainState of the run's structure), and their steps. Late in a
     decaying schedule the checkpoints lie close together, and their mean is at least as good as the last one on
-    validation (measured: README, lip-fast-indoor)."""
+    validation (measured: docs/training.md, lip-fast-indoor)."""
     manager = CheckpointManager(pathlib.Path(workdir) / "checkpoints", keep=config.keep_checkpoints)
     try:
         steps = sorted(manager.all_steps())[-count:]
