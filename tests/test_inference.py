@@ -131,3 +131,19 @@ def test_reproject_sparse_and_complete_frame_keep_measured_values(completer):
     dense = inference.complete_frame(methods.get_completer("linear"), rgb, sparse, max_side=16)
     assert dense.shape == (24, 32) and dense.dtype == np.float32
     np.testing.assert_array_equal(dense[sparse > 0], sparse[sparse > 0])
+
+
+def test_auto_initial_estimate_is_nearest_on_scan_lines_and_linear_on_scattered_points():
+    from lipjax.classical.interpolate import linear_fill
+    from lipjax.classical.nearest import nearest_fill
+    from lipjax.model import host_initial_estimate
+
+    rng = np.random.default_rng(0)
+    lines = np.zeros((40, 60), np.float32)
+    lines[5::6, ::2] = rng.uniform(1.0, 9.0, lines[5::6, ::2].shape)  # rows 6 px apart, samples 2 px apart
+    scattered = np.zeros((40, 60), np.float32)
+    scattered.reshape(-1)[rng.choice(40 * 60, 30, replace=False)] = rng.uniform(1.0, 9.0, 30)
+    out = host_initial_estimate("auto", np.stack([lines, scattered]))
+    np.testing.assert_array_equal(out[0], nearest_fill(lines))
+    np.testing.assert_array_equal(out[1], linear_fill(scattered))
+    assert not np.array_equal(nearest_fill(lines), linear_fill(lines))  # the two fills differ on this input
