@@ -22,7 +22,7 @@ import numpy as np
 
 from lipjax import model_io
 from lipjax.inputs import InputError, check_inputs  # noqa: F401  (lipjax.InputError)
-from lipjax.interfaces import LearnedModel
+from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
 from lipjax.shipped import DEFAULT_MODEL, DEFAULT_MODELS
@@ -75,18 +75,26 @@ class Completer:
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""
-        rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained)
+        rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained,
+                                             self.both_scenes)
         depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, self.config.host_inputs(sparse))
         depth = np.maximum(np.asarray(depth), 0.0)
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
         """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
-        rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained)
+        rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained,
+                                             self.both_scenes)
         return compiled_apply(self.config, True)(self.params, rgb, sparse, self.config.host_inputs(sparse))
 
     def parameter_count(self) -> int:
         return self.config.parameter_count(self.params)
+
+    @property
+    def both_scenes(self) -> bool:
+        """Whether the model was trained on rooms and streets together (its metadata's `data` is "mixed", recorded
+        at export by lipjax.train.run)."""
+        return self.metadata.get("data") == MIXED_SCENES
 
     @functools.cached_property  # read on every call: the spec is parsed once
     def scan_lines_trained(self) -> bool:

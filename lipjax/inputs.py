@@ -51,13 +51,14 @@ class InputError(ValueError):
 
 
 def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "this model",
-                 scan_lines_trained: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
+                 scan_lines_trained: bool = False, both_scenes: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
     """Validates and batches inputs. Returns (rgb (B,H,W,3) uint8|float32, sparse (B,H,W) float32, was_batched).
 
     Raises InputError for: a wrong rank or channel count, an rgb dtype other than uint8 / float in [0, 1],
     mismatching sizes, non-float sparse depth (a raw PNG), NaN / inf or negative depth, an image without any
     sample, and depth that is clearly not metres. With `max_depth_m`, the range (metres) of the model `name`,
-    also `check_for_model` (scan_lines_trained: the model's training input included LiDAR scan lines).
+    also `check_for_model` (scan_lines_trained: the model's training input included LiDAR scan lines;
+    both_scenes: it was trained on rooms and streets).
     """
     rgb = np.asarray(rgb)
     sparse = np.asarray(sparse)
@@ -88,7 +89,7 @@ def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "thi
     if median > MAX_PLAUSIBLE_DEPTH_M:
         raise InputError(f"sparse depth has a median of {median:.0f}: not metres (millimetres? divide by 1000)")
     if max_depth_m is not None:
-        check_for_model(sparse, max_depth_m, name, scan_lines_trained)
+        check_for_model(sparse, max_depth_m, name, scan_lines_trained, both_scenes)
     if np.issubdtype(rgb.dtype, np.floating):
         rgb = rgb.astype(np.float32)
     return rgb, sparse.astype(np.float32), batched
@@ -147,12 +148,13 @@ def _other_model(name: str, scene: str) -> str:
 
 
 def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model",
-                    scan_lines_trained: bool = False) -> None:
+                    scan_lines_trained: bool = False, both_scenes: bool = False) -> None:
     """Compares checked (B, H, W) or (H, W) sparse depth (metres) with what a model of range `max_depth_m` was
     trained on: raises InputError where a unit mistake is near certain, warns (one line) where it is probable or
     the input is unlike the training data. See the module docstring for the rules. scan_lines_trained: the
     model's training input included LiDAR scan lines (lipjax.inference.Completer.scan_lines_trained), so scan
-    lines are no warning for it."""
+    lines are no warning for it. both_scenes: the model was trained on rooms and streets (with scan lines), so only
+    the unit checks and the density warning apply."""
     sparse = np.asarray(sparse)
     samples = sparse[sparse > 0]
     median = float(np.median(samples))
@@ -162,7 +164,11 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
     indoor = max_depth_m <= INDOOR_DEPTH_M
     lidar = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
     density = samples.size / sparse.size
-    if indoor:
+    if both_scenes:
+        if median > max_depth_m or samples.max() > 4 * max_depth_m:
+            _warn(f"sparse depth far beyond the {max_depth_m:g} m range of {name}: centimetres given as metres? "
+                  "divide by 100")
+    elif indoor:
         outdoor_model = _other_model(name, "outdoor")
         if np.quantile(samples, 0.75) > max_depth_m and (lidar or samples.max() > KINECT_AT_256_M):
             _warn(f"sparse depth beyond the {max_depth_m:g} m range of the indoor model {name}: looks like outdoor "
@@ -182,7 +188,7 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
     elif not lidar and density > DENSE and samples.max() <= KINECT_AT_256_M:
         _warn(f"a dense depth map within {KINECT_AT_256_M:.0f} m: a millimetre PNG (Kinect, NYU) read with "
               f"--depth-scale 256 (use 1000), or indoor data (use {_other_model(name, 'indoor')})?")
-    trained = TRAINED_MIN_DENSITY["indoor" if indoor else "outdoor"]
+    trained = min(TRAINED_MIN_DENSITY.values()) if both_scenes else TRAINED_MIN_DENSITY["indoor" if indoor else "outdoor"]
     if density < trained / 4:
         _warn(f"samples on under a quarter as many pixels as in the sparsest input {name} was trained on "
               f"({100 * trained:.2g} % of the pixels): expect larger errors")

@@ -23,6 +23,9 @@ Params = Any
 
 # The depth range (metres) a model of each scene is made for: indoor rooms (Kinect, NYU) and streets (KITTI LiDAR).
 SCENE_MAX_DEPTH_M: dict[str, float] = {"indoor": 10.0, "outdoor": 85.0}
+# The synthetic data kind of rooms and streets interleaved (lipjax.data.synthetic.MixedSyntheticDataset), recorded
+# as a model's training `data`: such a model serves both scenes.
+MIXED_SCENES = "mixed"
 
 MODEL_TYPES: dict[str, type] = {}
 

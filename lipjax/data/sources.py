@@ -33,6 +33,7 @@ from lipjax.data.errors import dataset_error
 from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
+from lipjax.interfaces import MIXED_SCENES
 
 SOURCES = ("synthetic", "rendered", "nyu_h5", "nyu_tfds", "kitti_dc", "kitti_selection", "kitti_odometry", "tartanair",
            "folder")
@@ -141,10 +142,10 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
     source, root = data.source, data.root
     if source == "synthetic":
-        from lipjax.data.synthetic.dataset import MIXED_KIND, MixedSyntheticDataset, SyntheticDataset
+        from lipjax.data.synthetic.dataset import MixedSyntheticDataset, SyntheticDataset
 
         size = data.val_images if split == "val" else None
-        if data.kind == MIXED_KIND:
+        if data.kind == MIXED_SCENES:
             return MixedSyntheticDataset(split, size=size, height=data.height, width=data.width), None
         return SyntheticDataset(data.kind, split, size=size, height=data.height, width=data.width), None
     if root is None:
@@ -217,7 +218,7 @@ def range_protocol(data: Any) -> Protocol | None:
     they are, data.protocol="none") the source's default, synthetic_<data.kind> for the synthetic scenes; None for
     a folder."""
     if data.source in ("synthetic", "rendered"):
-        default = "synthetic_outdoor" if data.kind == "mixed" else f"synthetic_{data.kind}"  # 0-80 m holds both
+        default = "synthetic_outdoor" if data.kind == MIXED_SCENES else f"synthetic_{data.kind}"  # 0-80 m holds both
     else:
         default = DEFAULT_PROTOCOLS.get(data.source)
     return applied_protocol(data) or (get_protocol(default) if default else None)

@@ -12,6 +12,7 @@ from typing import Iterator
 import numpy as np
 
 from lipjax.data.sample import Intrinsics, Sample
+from lipjax.interfaces import MIXED_SCENES
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,
     DEFAULT_SIZES,
@@ -192,7 +193,6 @@ class SyntheticDataset:
                 f"width={self.width})")
 
 
-MIXED_KIND = "mixed"
 
 
 class MixedSyntheticDataset:
@@ -204,7 +204,7 @@ class MixedSyntheticDataset:
     points from a frame here as from the single-kind set.
     """
 
-    kind = MIXED_KIND
+    kind = MIXED_SCENES
 
     def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH):
         self.parts = tuple(SyntheticDataset(kind, split, None, height, width) for kind in SYNTHETIC_KINDS)
