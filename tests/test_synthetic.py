@@ -198,3 +198,18 @@ def test_default_size_is_the_documented_one():
     s = S.render("indoor", "val", 0)
     assert s.shape == (S.DEFAULT_HEIGHT, S.DEFAULT_WIDTH) == (256, 320)
     assert isinstance(s.intrinsics, Intrinsics)
+
+
+def test_mixed_dataset_interleaves_rooms_and_streets():
+    from lipjax.data.synthetic.dataset import MixedSyntheticDataset
+
+    mixed = MixedSyntheticDataset("val", size=4, height=32, width=40)
+    assert len(mixed) == 4
+    for i in range(4):
+        want = S.render(("indoor", "outdoor")[i % 2], "val", i // 2, 32, 40)
+        got = mixed[i]
+        assert got.id == want.id
+        np.testing.assert_array_equal(got.rgb, want.rgb)
+        np.testing.assert_array_equal(got.depth, want.depth)
+    with pytest.raises(IndexError):
+        mixed[4]
