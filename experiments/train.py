@@ -13,7 +13,8 @@ from __future__ import annotations
 import argparse
 import sys
 
-from lipjax.train.run import parse_overrides, run
+from lipjax.train.config import parse_overrides
+from lipjax.train.run import run
 from lipjax.utils import enable_compilation_cache
 
 
