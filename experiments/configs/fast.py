@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import (INDOOR, INDOOR_DATA, INDOOR_INITIAL_ESTIMATE, INDOOR_MAX_DEPTH_M, MIXED, OUTDOOR,
-                                      OUTDOOR_DATA, OUTDOOR_INITIAL_ESTIMATE, OUTDOOR_MAX_DEPTH_M, Expected, fast_model)
+from experiments.configs.base import (INDOOR, INDOOR_DATA, INDOOR_INITIAL_ESTIMATE, INDOOR_MAX_DEPTH_M, MIXED,
+                                      OUTDOOR, OUTDOOR_DATA, OUTDOOR_INITIAL_ESTIMATE, OUTDOOR_MAX_DEPTH_M, Expected,
+                                      fast_model)
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
@@ -44,7 +45,8 @@ LIP_AD_FAST_INDOOR = dataclasses.replace(
     eval_every=500, checkpoint_every=100,
 )
 LIP_AD_FAST_OUTDOOR = dataclasses.replace(
-    OUTDOOR, name="lip-ad-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA, init_from="lip-fast-outdoor",
+    OUTDOOR, name="lip-ad-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA,
+    init_from="lip-fast-outdoor",
     g_steps=0, d_steps=100, adv_steps=300, learning_rate=5e-5, warmup_steps=20, adv_weight=1e-3,
     discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M, inputs="log_gradients"),
     eval_every=500, checkpoint_every=100,
@@ -73,6 +75,7 @@ EXPECTED: dict[str, Expected] = {
         val_rmse_m=3.557457, images_seen=74_400, budget_from_config=False,
         note="this config from the 64,000-image lip-fast-indoor, before its third run (from today's: 110,400)"),
     "lip_ad_fast_indoor": Expected(
-        val_rmse_m=0.1690931, images_seen=103_200, note="exported as the mean of its last 3 checkpoints (--average 3)"),
+        val_rmse_m=0.1690931, images_seen=103_200,
+        note="this config from the 100,000-image lip-fast-indoor, exported as the mean of its last 3 checkpoints"),
     "lip_ad_fast_outdoor": Expected(val_rmse_m=3.454171, images_seen=77_600),
 }

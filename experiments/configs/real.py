@@ -70,5 +70,6 @@ CONFIGS: dict[str, TrainConfig] = {
 REAL_DATA_BASELINES: dict[str, TrainConfig] = {
     f"{key}_{data}": baseline(base, f"{key}-{data}", model_type, **run)
     for key, model_type in BASELINE_TYPES.items()
-    for data, base, run in (("nyu", INDOOR, NYU_RUN), ("kitti", OUTDOOR, KITTI_RUN), ("tartanair", OUTDOOR, TARTANAIR_RUN))
+    for data, base, run in (("nyu", INDOOR, NYU_RUN), ("kitti", OUTDOOR, KITTI_RUN),
+                            ("tartanair", OUTDOOR, TARTANAIR_RUN))
 }
