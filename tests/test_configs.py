@@ -3,6 +3,7 @@ config is at most one `dataclasses.replace` from a scene base, and `--set` overr
 import dataclasses
 import importlib
 import json
+import re
 import sys
 
 import pytest
@@ -91,3 +92,16 @@ def test_overrides_are_the_librarys_and_apply_to_any_train_config():
         parse_overrides(["=3"])
     with pytest.raises(ValueError, match="takes int, not 'x'"):
         apply_overrides(config, {"batch_size": "x"})
+
+
+def test_trained_min_density_is_the_sparsest_scattered_input_of_the_shipped_configs():
+    """lipjax.inputs cannot read experiments/ (nor do 12 of the 14 shipped models record their samplers): this test
+    keeps its copy of the configs' facts true."""
+    from lipjax.inputs import TRAINED_MIN_DENSITY
+
+    scattered = re.compile(r"(uniform|bernoulli):(\d+)")  # N points, whatever noise follows
+    for scene, density in TRAINED_MIN_DENSITY.items():
+        data = [CONFIGS[key].data for key in EXPECTED if CONFIGS[key].data.kind == scene]
+        per_pixel = [int(match[2]) / (d.height * d.width) for d in data
+                     for match in map(scattered.match, d.train_sampler.split("|")) if match]
+        assert len(data) >= 6 and min(per_pixel) == density
