@@ -73,7 +73,7 @@ EXPECTED: dict[str, Expected] = {
              "4,500 steps with scan lines at learning rate 1e-4, exported as the mean of its last 4 checkpoints"),
     "lip_fast_outdoor": Expected(
         val_rmse_m=3.557457, images_seen=74_400, budget_from_config=False,
-        note="this config from the 64,000-image lip-fast-indoor, before its third run (from today's: 110,400)"),
+        note="this config from the 64,000-image lip-fast-indoor (from the shipped one: 110,400 images)"),
     "lip_ad_fast_indoor": Expected(
         val_rmse_m=0.1690931, images_seen=103_200,
         note="this config from the 100,000-image lip-fast-indoor, exported as the mean of its last 3 checkpoints"),

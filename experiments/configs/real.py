@@ -41,9 +41,9 @@ KITTI_RUN: dict[str, Any] = dict(data=KITTI_PAPER_DATA, batch_size=8, g_steps=30
                                  eval_every=1000, checkpoint_every=500)
 TARTANAIR_RUN: dict[str, Any] = dict(NYU_RUN, data=TARTANAIR_DATA)
 
-# TartanAir spans indoor and outdoor depths: the outdoor (log-depth) LIP.
 LIP_CNN_NYU = dataclasses.replace(INDOOR, name="lip-cnn-nyu", **NYU_RUN)
 LIP_CNN_KITTI = dataclasses.replace(OUTDOOR, name="lip-cnn-kitti", **KITTI_RUN)
+# TartanAir spans indoor and outdoor depths: the outdoor (log-depth) LIP.
 LIP_CNN_TARTANAIR = dataclasses.replace(OUTDOOR, name="lip-cnn-tartanair", **TARTANAIR_RUN)
 # LIP+AD from the exported LIP+CNN model: D pretrained 500 steps with G frozen, then 2,000 joint steps.
 LIP_AD_NYU = dataclasses.replace(
