@@ -93,9 +93,8 @@ OUTDOOR = TrainConfig(
     batch_size=8, g_steps=900, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
     inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
 )
-# One model for rooms and streets: the shared-encoder prox (it never sees a metric depth) with the outdoor range,
-# started from the linear fill (the reference it has to beat everywhere), each frame's error in units of its own
-# sample scale (loss_scale="samples"). Its schedule is its config's (fast.py, lip_any).
+# Rooms and streets: the shared-encoder prox (it never sees a metric depth) from the linear fill, each frame's error
+# in units of its own sample scale. No schedule: its config (fast.py, lip_any) sets it.
 MIXED = TrainConfig(
     name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE), data=MIXED_DATA,
     batch_size=8, loss="l1", loss_scale="samples",
