@@ -1,4 +1,4 @@
-"""Trains a model from a named config (experiments/configs.py) on any data source: a thin caller of lipjax.train.
+"""Trains a model from a named config (experiments/configs/) on any data source: a thin caller of lipjax.train.
 
     python -m experiments.train --config lip_cnn_indoor [--workdir runs/lip_cnn_indoor] [--set g_steps=200]
     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
@@ -13,12 +13,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from lipjax.train.run import parse_overrides, run
+from lipjax.train.config import parse_overrides
+from lipjax.train.run import run
 from lipjax.utils import enable_compilation_cache
 
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(prog="train", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = argparse.ArgumentParser(prog="train", description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--config", required=True, help="a name of experiments.configs.CONFIGS")
     p.add_argument("--workdir", default=None, help="default: runs/<config>")
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", help="override a config field")

@@ -29,16 +29,17 @@ import warnings
 
 import numpy as np
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.shipped import DEFAULT_MODELS, available
 
 # A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
-# The deepest indoor samples (Kinect, NYU v2); also the range of the indoor models (config.max_depth_m, 85 m outdoor).
-INDOOR_DEPTH_M = 10.0
+# The deepest indoor samples (Kinect, NYU v2): the range of the indoor models (lipjax.interfaces).
+INDOOR_DEPTH_M = SCENE_MAX_DEPTH_M["indoor"]
 # Input whose median sample depth exceeds this is outdoor data (no room is that deep).
 OUTDOOR_MEDIAN_M = 12.0
-# Sparsest training input of the shipped models, samples per pixel (experiments/configs.py: indoor uniform:100 on
-# 256x320, outdoor uniform:200 on 128x416); a warning below a quarter of it.
+# Sparsest training input of the shipped models, samples per pixel (indoor uniform:100 on 256x320, outdoor uniform:200
+# on 128x416; tests/test_configs.py checks it against their configs); a warning below a quarter of it.
 TRAINED_MIN_DENSITY = {"indoor": 100 / (256 * 320), "outdoor": 200 / (128 * 416)}
 # Indoor depth (<= 10 m) stored in millimetres but read with --depth-scale 256 reaches at most this.
 KINECT_AT_256_M = INDOOR_DEPTH_M * 1000 / 256

@@ -28,6 +28,8 @@ from collections.abc import Mapping, Sequence
 import cv2
 import numpy as np
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+
 DEFAULT_DEPTH_CMAP = "turbo"
 DEFAULT_ERROR_CMAP = "jet"
 INVALID_COLOR = (0, 0, 0)
@@ -55,7 +57,7 @@ def _apply(values: np.ndarray, lo: float, hi: float, draw: np.ndarray, cmap: str
     return out
 
 
-def colorize_depth(depth_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
+def colorize_depth(depth_m: np.ndarray, min_m: float = 0.0, max_m: float = SCENE_MAX_DEPTH_M["indoor"],
                    cmap: str = DEFAULT_DEPTH_CMAP) -> np.ndarray:
     """Depth (H, W) metres -> (H, W, 3) uint8 RGB over the fixed range [min_m, max_m]; invalid (<= 0) black."""
     depth = np.asarray(depth_m)
@@ -82,7 +84,7 @@ def fitting_range(depth_m: np.ndarray, max_m: float) -> tuple[float, float]:
     return (0.0, float(max_m)) if max_m / 4 <= p <= max_m else (0.0, p)
 
 
-def colorize_sparse(sparse_m: np.ndarray, min_m: float = 0.0, max_m: float = 10.0,
+def colorize_sparse(sparse_m: np.ndarray, min_m: float = 0.0, max_m: float = SCENE_MAX_DEPTH_M["indoor"],
                     cmap: str = DEFAULT_DEPTH_CMAP, radius: int = 2) -> np.ndarray:
     """A sparse depth map drawn with each sample enlarged to a (2 radius + 1)^2 square, for visibility.
 

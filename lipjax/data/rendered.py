@@ -42,7 +42,7 @@ from lipjax.data.sampling import example_rng
 
 FORMAT = "lipjax-rendered-v1"
 INDEX = "index.json"
-# Full-frame size per kind, as the shipped training configs render them (experiments/configs.py).
+# Full-frame size per kind, as the shipped training configs render them (experiments/configs/base.py).
 TRAINING_SIZES = {"indoor": (256, 320), "outdoor": (128, 416)}
 # uint16 depth: value per metre. Indoor 1 mm steps up to 65.5 m; outdoor KITTI's 1/256 m up to 256 m.
 DEPTH_SCALES = {"indoor": 1000.0, "outdoor": 256.0}

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.networks.cspn import CSPN, CSPNNet, normalize_affinity, propagate
 from lipjax.networks.sparse_to_dense import SparseToDense, SparseToDenseNet
 from lipjax.networks.unet import UNet, UNetNet
@@ -59,7 +60,7 @@ PRESETS: dict[str, dict[str, object]] = {
 }
 
 
-def baseline_preset(model: str, size: str, max_depth_m: float = 10.0):
+def baseline_preset(model: str, size: str, max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]):
     """PRESETS[model][size] with the depth normalisation of the target scenes (10 m indoors, 85 m outdoors)."""
     if model not in PRESETS:
         raise ValueError(f"unknown baseline network {model!r}; choose one of {sorted(PRESETS)}")

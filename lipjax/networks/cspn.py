@@ -9,7 +9,7 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
-from lipjax.interfaces import register_model_type
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
 from lipjax.networks.common import NetworkModel, check_max_depth, network_input
 from lipjax.networks.unet import UNetBody
 
@@ -107,7 +107,7 @@ class CSPN(NetworkModel):
     base_width: int = 64
     levels: int = 4
     iterations: int = 12
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
 
     def __post_init__(self):
         check_max_depth(self.max_depth_m)

@@ -6,7 +6,7 @@ import dataclasses
 import flax.linen as nn
 import jax
 
-from lipjax.interfaces import register_model_type
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
 from lipjax.networks.common import NetworkModel, check_max_depth, group_norm
 from lipjax.priors.network import UpProjection
 
@@ -79,7 +79,7 @@ class SparseToDense(NetworkModel):
 
     width_multiplier: float = 1.0
     blocks: tuple[int, ...] = (2, 2, 2, 2)
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
 
     multiple = 32  # the encoder's total downsampling (class attribute, not a field)
 

@@ -6,7 +6,7 @@ import dataclasses
 import flax.linen as nn
 import jax.numpy as jnp
 
-from lipjax.interfaces import register_model_type
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
 from lipjax.networks.common import NetworkModel, check_max_depth, depth_to_space2, group_norm
 
 
@@ -75,7 +75,7 @@ class UNet(NetworkModel):
 
     base_width: int = 64
     levels: int = 4
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
 
     def __post_init__(self):
         check_max_depth(self.max_depth_m)

@@ -31,6 +31,7 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.priors.base import EncodedGuidance, SharedEncoderPrior
 
 DOWNSAMPLING = 8  # space-to-depth, then two stride-2 stages
@@ -222,7 +223,7 @@ class GuidedPrior(SharedEncoderPrior):
 
     encoder_widths: tuple[int, int, int] = (32, 48, 64)
     branch_widths: tuple[int, int, int] = (24, 48, 64)
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
 
     def __post_init__(self):
         for name in ("encoder_widths", "branch_widths"):

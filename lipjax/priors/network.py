@@ -38,6 +38,8 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+
 DOWNSAMPLING = 8  # three stride-2 bottleneck blocks
 LOG_DOMAIN_FLOOR = 1e-3  # depth_domain="log": v is floored at this fraction of max_depth before the log
 DEPTH_DOMAINS = ("linear", "log")
@@ -127,7 +129,7 @@ class NetworkPrior:
     stem_width: int = 16
     bottleneck_widths: tuple[int, int, int] = (8, 16, 24)
     up_widths: tuple[int, int, int] = (32, 24, 16)
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
     depth_domain: str = "linear"  # "log": relative corrections, positive output (see the module docstring)
 
     def __post_init__(self):
@@ -160,7 +162,7 @@ PRESETS: dict[str, NetworkPrior] = {
 }
 
 
-def network_preset(name: str, max_depth_m: float = 10.0) -> NetworkPrior:
+def network_preset(name: str, max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]) -> NetworkPrior:
     """A preset by name, with the depth normalisation of the target scenes (metres)."""
     if name not in PRESETS:
         raise ValueError(f"unknown network preset {name!r}; choose one of {sorted(PRESETS)}")

@@ -36,6 +36,8 @@ import math
 import jax
 import jax.numpy as jnp
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+
 _SQRT2 = math.sqrt(2.0)
 _SQRT3 = math.sqrt(3.0)
 
@@ -178,7 +180,7 @@ class WaveletPrior:
     wavelet: str = "haar"
     threshold_m: float = 0.05
     shifts: int = 1
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
 
     def __post_init__(self):
         wavelet_filters(self.wavelet)  # validates the name

@@ -1,4 +1,5 @@
-"""Training configuration as typed, frozen dataclasses (configs are code: see experiments/configs.py).
+"""Training configuration as typed, frozen dataclasses (configs are code: see experiments/configs/), and the
+`--set FIELD=VALUE` overrides of `python -m experiments.train` (parse_overrides, apply_overrides).
 
 A run has up to three phases, by global step:
     [0, g_steps)                      G supervised pretraining (L2 through the whole unrolled solver)
@@ -103,3 +104,61 @@ class TrainConfig:
     @property
     def adversarial(self) -> bool:
         return self.d_steps + self.adv_steps > 0
+
+
+def parse_overrides(items: list[str]) -> dict[str, str]:
+    """["a.b=1", ...] (the --set arguments) -> {"a.b": "1"}; one-line ValueError for an item without '=' or a field."""
+    overrides = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise ValueError(f"--set {item!r}: expected FIELD=VALUE, e.g. --set g_steps=200")
+        overrides[key.strip()] = value
+    return overrides
+
+
+def apply_overrides(config: TrainConfig, overrides: dict[str, str] | None) -> TrainConfig:
+    """`config` with `field=value` overrides of scalar fields, nested ones dotted; one-line ValueError for an
+    unknown field, a group, or a value the field's type cannot take.
+
+    E.g. {'g_steps': '200'} or {'data.num_workers': '8'} (more loader processes on a machine with many cores).
+    """
+    for key, text in (overrides or {}).items():
+        config = _override(config, key.split("."), text, key)
+    return config
+
+
+def _override(obj, path: list[str], text: str, key: str):
+    """`obj` (a frozen dataclass) with the field at `path` set to `text` converted to the field's current type."""
+    fields = {f.name: f for f in dataclasses.fields(obj)}
+    if path[0] not in fields:
+        raise ValueError(f"unknown config field {key!r}; fields of {type(obj).__name__}: {sorted(fields)}")
+    current = getattr(obj, path[0])
+    if len(path) > 1:
+        if not dataclasses.is_dataclass(current):
+            raise ValueError(f"config field {key!r}: {path[0]!r} has no sub-fields")
+        value = _override(current, path[1:], text, key)
+    elif dataclasses.is_dataclass(current):
+        raise ValueError(f"config field {key!r} is a group; set one of its fields, e.g. {key}.<field>=...")
+    else:
+        value = _parse_value(text, str(fields[path[0]].type), current, key)
+    return dataclasses.replace(obj, **{path[0]: value})
+
+
+def _parse_value(text: str, annotation: str, current, key: str):
+    """`text` as the type of a field: its current value's type, else the first type of its annotation."""
+    if text == "None":
+        return None
+    kind = type(current) if current is not None else annotation.split("|")[0].split("[")[0].strip()
+    try:
+        if kind in (bool, "bool"):  # bool("False") would be True
+            if text.lower() not in ("true", "false"):
+                raise ValueError
+            return text.lower() == "true"
+        if kind in (tuple, "tuple"):  # e.g. a crop "128,160", or a zoom range "0.75,1.33" (float like the field)
+            element = float if any(isinstance(v, float) for v in current or ()) else int
+            return tuple(element(v) for v in text.split(","))
+        return {"int": int, "float": float, "str": str}.get(kind, kind)(text)
+    except ValueError:
+        want = "true or false" if kind in (bool, "bool") else getattr(kind, "__name__", kind)
+        raise ValueError(f"config field {key!r} takes {want}, not {text!r}") from None

@@ -20,6 +20,7 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 
 DISCRIMINATOR_INPUTS = ("depth", "log_gradients")
 LOG_GRADIENT_GAIN = 10.0  # a 10 % depth step between neighbours becomes ~1: unit-scale inputs for the convolutions
@@ -60,7 +61,7 @@ class Discriminator:
     """Config + functional init/apply. apply(params, depth (B,H,W) m, rgb (B,H,W,3) [0,1], valid (B,H,W)) -> logits."""
 
     widths: tuple[int, ...] = (16, 32, 64, 64)
-    max_depth_m: float = 10.0
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
     inputs: str = "depth"
 
     def __post_init__(self):

@@ -9,7 +9,7 @@ being skipped: a skipped frame would change which frames every later batch holds
 the seed and s, so that resume is exact) and would hide a broken copy; one pass reading every file costs a few
 milliseconds a frame, and its error names every bad file at once.
 
-`lipjax train --data DIR` starts from `default_init`; the named config lip_cnn_folder (experiments/configs.py) is
+`lipjax train --data DIR` starts from `default_init`; the named config lip_cnn_folder (experiments/configs/real.py) is
 the same run started from lip-cnn-indoor, folder_config(LIP_CNN_INDOOR's model, "lip-cnn-indoor").
 """
 from __future__ import annotations

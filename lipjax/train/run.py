@@ -25,17 +25,6 @@ from lipjax.train.loop import evaluate_params, export as export_model, train, va
 from lipjax.train.state import init_state
 
 
-def parse_overrides(items: list[str]) -> dict[str, str]:
-    """["a.b=1", ...] -> {"a.b": "1"}; one-line ValueError for an item without '=' or a field."""
-    overrides = {}
-    for item in items:
-        key, sep, value = item.partition("=")
-        if not sep or not key.strip():
-            raise ValueError(f"--set {item!r}: expected FIELD=VALUE, e.g. --set g_steps=200")
-        overrides[key.strip()] = value
-    return overrides
-
-
 def logged_validation(metrics_path: pathlib.Path, step: int) -> dict | None:
     """The validation metrics the training loop logged at `step`, if any."""
     if not metrics_path.exists():

@@ -1,0 +1,102 @@
+"""The scene bases every named config is built from, in one `dataclasses.replace`: INDOOR, OUTDOOR and MIXED.
+
+A base holds what its scene needs (data, model, loss) and the synthetic LIP+CNN schedule; a named config
+(experiments/configs/paper.py, fast.py, real.py) changes the run: its name, model variant, data source, budget.
+Why each choice was made, and the runs behind it: docs/training.md, "Run history from experiments/configs.py".
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.model import LIPConfig
+from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
+from lipjax.priors.network import network_preset
+from lipjax.train.config import DataConfig, TrainConfig
+
+INDOOR_MAX_DEPTH_M = SCENE_MAX_DEPTH_M["indoor"]  # the models' depth range (lipjax.interfaces)
+OUTDOOR_MAX_DEPTH_M = SCENE_MAX_DEPTH_M["outdoor"]
+
+
+@dataclasses.dataclass(frozen=True)
+class Expected:
+    """What a config's shipped model (lipjax/weights/<config name>) reached, as its metadata records it.
+
+    val_rmse_m: validation RMSE (metres) on the config's val_sampler and val_images, to 7 significant digits.
+    images_seen: training images of all its steps, with those of the model it started from (init_from).
+    budget_from_config: its steps and images follow from this config as written (steps = total_steps, from the
+      shipped init_from model); False where it was trained in several runs or from an older init model (note).
+    note: how it was trained, where that is more than this config.
+    """
+
+    val_rmse_m: float
+    images_seen: int
+    budget_from_config: bool = True
+    note: str = ""
+
+
+# Rooms: random 128x160 crops of 256x320 renders. Streets: 128x208 crops of 128x416 (KITTI-aspect) renders. A
+# mixture of sparse patterns, so that one model serves several sensors (lipjax.data.sampling.Mixture).
+INDOOR_DATA = DataConfig(
+    kind="indoor", height=256, width=320, crop=(128, 160),
+    train_sampler="uniform:200|uniform:100|uniform:500|uniform:1000|bernoulli:200",
+    val_sampler="uniform:200", val_images=32,
+)
+OUTDOOR_DATA = DataConfig(
+    kind="outdoor", height=128, width=416, crop=(128, 208),
+    train_sampler="lidar:hdl64|lidar:vlp32|lidar:vlp16|uniform:500|uniform:200",
+    val_sampler="lidar:hdl64", val_images=32,
+)
+# Rooms and streets interleaved, both rendered at 256x320: 50 to 5,000 scattered points, 16- to 64-beam scans at
+# random mount pitch, noise and bleed-through outliers on some, colour texture without depth edges.
+MIXED_SAMPLER = "|".join((
+    "uniform:50", "uniform:200", "uniform:200", "uniform:500", "uniform:1000", "uniform:5000", "bernoulli:2000",
+    "uniform:300+noise:rel=0.01,outliers=0.03",
+    "lidar:hdl64,azimuth_step_deg=0.4", "lidar:vlp32,azimuth_step_deg=0.3,mount_pitch_deg=-3",
+    "lidar:vlp16,azimuth_step_deg=0.4,mount_pitch_deg=2", "lidar:hdl64+noise:rel=0.005,outliers=0.02",
+))
+MIXED_DATA = dataclasses.replace(
+    INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
+    augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.6, 1.6), texture_prob=0.3),
+)
+
+# z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest
+# validation MAE per scene. Linear interpolation across the depth jumps between LiDAR rows is worse outdoors.
+INDOOR_INITIAL_ESTIMATE = "linear"
+OUTDOOR_INITIAL_ESTIMATE = "nearest"
+
+
+def lip_model(max_depth_m: float, initial_estimate: str, output: str = "x",
+              depth_domain: str = "linear") -> LIPConfig:
+    """The paper-style LIP: the "small" network prox (lipjax.priors.network), 3 iterations."""
+    prior = dataclasses.replace(network_preset("small", max_depth_m=max_depth_m), depth_domain=depth_domain)
+    return LIPConfig(prior=prior, num_iterations=3, initial_estimate=initial_estimate, output=output)
+
+
+def fast_model(max_depth_m: float, initial_estimate: str) -> LIPConfig:
+    """The shared-encoder prox (lipjax.priors.guided "fast"), read out from the last prox (always positive)."""
+    prior = dataclasses.replace(GUIDED_PRESETS["fast"], max_depth_m=max_depth_m)
+    return LIPConfig(prior=prior, num_iterations=3, initial_estimate=initial_estimate, output="z")
+
+
+# L1, not the paper's L2: L2 hedges between the two sides of a depth edge, which costs MAE.
+INDOOR = TrainConfig(
+    name="indoor", model=lip_model(INDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE), data=INDOOR_DATA,
+    batch_size=8, g_steps=1200, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
+)
+# Outdoors the prox works in log depth, read out from the last prox (no depth <= 0 is possible), and an
+# inverse-depth term keeps thin poles above the top beam from ruining iRMSE.
+OUTDOOR = TrainConfig(
+    name="outdoor", data=OUTDOOR_DATA,
+    model=lip_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE, output="z", depth_domain="log"),
+    batch_size=8, g_steps=900, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
+    inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
+)
+# Rooms and streets: the shared-encoder prox (it never sees a metric depth) from the linear fill, each frame's error
+# in units of its own sample scale. No schedule: its config (fast.py, lip_any) sets it.
+MIXED = TrainConfig(
+    name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE), data=MIXED_DATA,
+    batch_size=8, loss="l1", loss_scale="samples",
+)
+SCENES: dict[str, TrainConfig] = {"indoor": INDOOR, "outdoor": OUTDOOR, "mixed": MIXED}

@@ -1,0 +1,106 @@
+"""The named training configs (experiments/configs/): each shipped model reached what its config states, each
+config is at most one `dataclasses.replace` from a scene base, and `--set` overrides live in the library."""
+import dataclasses
+import importlib
+import json
+import re
+import sys
+
+import pytest
+
+from experiments.configs import CONFIGS, EXPECTED
+from lipjax import model_io
+from lipjax.shipped import WEIGHTS_DIR, available
+from lipjax.train.config import TrainConfig, apply_overrides, parse_overrides
+from lipjax.train.folder import folder_config
+
+
+def _shipped_docs() -> dict[str, dict]:
+    """Config key -> the model file's document, for every shipped model whose metadata names its train_config."""
+    docs = [json.loads((WEIGHTS_DIR / f"{name}.json").read_text()) for name in available()]
+    return {doc["metadata"]["train_config"].replace("-", "_"): doc for doc in docs
+            if "train_config" in doc.get("metadata", {})}
+
+
+def test_every_shipped_model_has_an_expected_result_and_every_expected_result_a_shipped_model():
+    shipped = _shipped_docs()
+    assert len(shipped) == len(available()) > 0  # every shipped model names the config that trained it
+    assert set(EXPECTED) == set(shipped)
+
+
+@pytest.mark.parametrize("key", sorted(_shipped_docs()))
+def test_shipped_model_reached_its_configs_expected_result(key):
+    doc, config, expected = _shipped_docs()[key], CONFIGS[key], EXPECTED[key]
+    meta = doc["metadata"]
+    assert meta["train_config"] == config.name
+    assert meta["val_metrics"]["rmse_m"] == pytest.approx(expected.val_rmse_m, rel=1e-6)
+    assert meta["images_seen"] == expected.images_seen
+    # validated as the config validates, so the RMSE is the config's to state
+    assert (meta["val_sampler"], meta["val_images"]) == (config.data.val_sampler, config.data.val_images)
+    assert model_io.config_from_dict(doc["config"]) == config.model  # the config's model, field for field
+    if expected.budget_from_config:
+        started = model_io.metadata(config.init_from)["images_seen"] if config.init_from else 0
+        assert meta["steps"] == config.total_steps
+        assert meta["images_seen"] == started + config.total_steps * config.batch_size
+    else:
+        assert expected.note  # a budget the config alone does not give is explained
+
+
+def _replace_depths(monkeypatch) -> tuple[object, dict[int, tuple[TrainConfig, int, TrainConfig]]]:
+    """Imports experiments.configs afresh with `dataclasses.replace` traced. Returns the module and, per TrainConfig
+    made by a replace: id -> (config, replaces since the last TrainConfig built without one, that config)."""
+    made: dict[int, tuple[TrainConfig, int, TrainConfig]] = {}
+    replace = dataclasses.replace
+
+    def traced(obj, /, **changes):
+        new = replace(obj, **changes)
+        if isinstance(new, TrainConfig):
+            _, depth, root = made.get(id(obj), (obj, 0, obj))
+            made[id(new)] = (new, depth + 1, root)
+        return new
+
+    monkeypatch.setattr(dataclasses, "replace", traced)
+    for name in [m for m in sys.modules if m == "experiments.configs" or m.startswith("experiments.configs.")]:
+        monkeypatch.delitem(sys.modules, name)
+    module = importlib.import_module("experiments.configs")
+    monkeypatch.setattr(dataclasses, "replace", replace)
+    return module, made
+
+
+def test_every_config_is_at_most_one_replace_from_a_scene_base(monkeypatch):
+    configs, made = _replace_depths(monkeypatch)
+    bases = configs.base.SCENES
+    assert all(id(base) not in made for base in bases.values())  # the bases are built directly
+    derived = {key: made[id(config)] for key, config in configs.CONFIGS.items() if id(config) in made}
+    assert {key: depth for key, (_, depth, _) in derived.items() if depth > 1} == {}
+    from_base = {key: next(scene for scene, base in bases.items() if root is base)
+                 for key, (_, _, root) in derived.items() if any(root is base for base in bases.values())}
+    assert set(from_base) == set(derived)  # every replace starts from a scene base
+    assert set(configs.CONFIGS) - set(derived) == {"smoke", "lip_cnn_folder"}  # built directly (folder_config)
+    assert from_base["lip_any"] == "mixed" and from_base["lip_cnn_kitti"] == "outdoor"
+    assert from_base["cspn_nyu"] == "indoor"
+
+
+def test_overrides_are_the_librarys_and_apply_to_any_train_config():
+    config = folder_config(CONFIGS["lip_cnn_indoor"].model, "lip-cnn-indoor")  # as `lipjax train` builds it
+    changed = apply_overrides(config, parse_overrides(["g_steps=7", "data.crop=64,80", "init_from=None"]))
+    assert (changed.g_steps, changed.data.crop, changed.init_from) == (7, (64, 80), None)
+    assert dataclasses.replace(changed, g_steps=config.g_steps, data=config.data, init_from=config.init_from) == config
+    assert apply_overrides(config, None) is config
+    with pytest.raises(ValueError, match="expected FIELD=VALUE"):
+        parse_overrides(["=3"])
+    with pytest.raises(ValueError, match="takes int, not 'x'"):
+        apply_overrides(config, {"batch_size": "x"})
+
+
+def test_trained_min_density_is_the_sparsest_scattered_input_of_the_shipped_configs():
+    """lipjax.inputs cannot read experiments/ (nor do 12 of the 14 shipped models record their samplers): this test
+    keeps its copy of the configs' facts true."""
+    from lipjax.inputs import TRAINED_MIN_DENSITY
+
+    scattered = re.compile(r"(uniform|bernoulli):(\d+)")  # N points, whatever noise follows
+    for scene, density in TRAINED_MIN_DENSITY.items():
+        data = [CONFIGS[key].data for key in EXPECTED if CONFIGS[key].data.kind == scene]
+        per_pixel = [int(match[2]) / (d.height * d.width) for d in data
+                     for match in map(scattered.match, d.train_sampler.split("|")) if match]
+        assert len(data) >= 6 and min(per_pixel) == density
