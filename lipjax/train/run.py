@@ -101,9 +101,9 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         params, steps = averaged_params(config, workdir, jax.device_get(state), average)
         state, averaged = state.replace(g_params=params), {"checkpoints": steps}
         val = evaluate_params(config.model, params, validation_batches(config), config.model.max_depth_m)
-    else:
-        val = logged_validation(workdir / "metrics.jsonl", int(state.step))
-    if val is None:  # not evaluated at this step by the loop (e.g. --export-only of an older checkpoint)
+    else:  # --export-only evaluates again: its config may differ from the run's in what the model is given
+        val = None if export_only else logged_validation(workdir / "metrics.jsonl", int(state.step))
+    if val is None:
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
     if (workdir / "metrics.jsonl").exists():
         plot_curves(workdir / "metrics.jsonl", workdir / "curves.png", title=config.name)
