@@ -27,7 +27,7 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.sample import Intrinsics, Sample
-from lipjax.pointcloud import as_intrinsics
+from lipjax.pointcloud import IntrinsicsLike, as_intrinsics
 
 RGB_SUFFIXES = (".png", ".jpg", ".jpeg")
 DEPTH_SUFFIXES = (".png", ".npy")
@@ -43,6 +43,20 @@ FOLDER_SOURCE = "your own frames (lipjax.data.folder.FolderDataset)"
 _DIGITS = re.compile(r"(\d+)")
 # Stands in for the intrinsics of a folder without any, where nothing reads them (FolderDataset).
 UNUSED_INTRINSICS = Intrinsics(1.0, 1.0, 0.0, 0.0)
+
+
+def parse_depth_scale(text: str) -> float:
+    """A PNG depth value per metre (> 0) from a number or a sensor's name in KNOWN_DEPTH_SCALES (kitti, nyu,
+    tum); ValueError otherwise."""
+    if text.lower() in KNOWN_DEPTH_SCALES:
+        return KNOWN_DEPTH_SCALES[text.lower()]
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"expected a number or one of {sorted(KNOWN_DEPTH_SCALES)}, got {text!r}") from None
+    if not value > 0:
+        raise ValueError(f"must be > 0, got {text}")
+    return value
 
 
 def natural_key(text: str) -> tuple:
@@ -147,6 +161,16 @@ def read_intrinsics_txt(path: str | os.PathLike, camera: int = 2) -> Intrinsics:
         return as_intrinsics(np.asarray(values).reshape(3, 3) if len(values) == 9 else values)
     except ValueError as exc:
         raise dataset_error(str(exc), path) from exc
+
+
+def read_intrinsics(intrinsics: IntrinsicsLike | str | os.PathLike | None, camera: int = 2) -> Intrinsics | None:
+    """Checked Intrinsics (pixels) from an Intrinsics, (fx, fy, cx, cy) or a 3x3 K (lipjax.pointcloud.as_intrinsics),
+    or from a file `read_intrinsics_txt` reads (KITTI camera `camera` of a calibration file); None stays None."""
+    if intrinsics is None:
+        return None
+    if isinstance(intrinsics, (str, os.PathLike)):
+        return read_intrinsics_txt(intrinsics, camera)
+    return as_intrinsics(intrinsics)
 
 
 def read_frame(rgb_path: str | os.PathLike, depth_path: str | os.PathLike,
