@@ -26,17 +26,18 @@ import sys
 import time
 import warnings
 from collections.abc import Callable, Iterable, Iterator
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from lipjax import inference
 from lipjax.data.folder import (check_one_depth_format, output_format, pair_frames, read_frame, read_intrinsics,
                                 write_depth)
 from lipjax.data.lidar import read_lidar_frame
 from lipjax.data.sample import Intrinsics
-from lipjax.inference import LARGE_FRAME_PIXELS, Completer, complete_frame, frame_size
+from lipjax.inference import Completer, complete_frame, frame_size
 from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
@@ -307,7 +308,7 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
         scene, why = scene_reason(sparse)
         log(f"model: {completer.name}, the default for {scene} input ({why}); choose another with --model")
     h, w = frame_size(completer, sparse, max_side)
-    if max_side is None and h * w > LARGE_FRAME_PIXELS:
+    if max_side is None and h * w > inference.LARGE_FRAME_PIXELS:  # read here: tests lower it
         warnings.warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) "
                       "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized "
                       "(--max-side 416 with the shipped outdoor models, their training scale)", stacklevel=2)
