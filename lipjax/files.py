@@ -278,19 +278,29 @@ def prefetched(read: Callable[[Any], Any], items: Iterable[Any], workers: int = 
 
 class _Writer:
     """Runs `_Output.write` on one background thread, in order; the model waits only when WRITE_BACKLOG frames
-    wait. Leaving the block waits for every queued frame, and raises the first error of a write."""
+    wait. After a failed write the frames queued behind it are not written. Leaving the block waits for every
+    queued frame, and raises the first error of a write."""
 
     def __init__(self, output: _Output):
-        self.output, self.pending = output, collections.deque()
+        self.output, self.pending, self.failed = output, collections.deque(), False
         self.pool = ThreadPoolExecutor(1, thread_name_prefix="lipjax-write")
 
     def __enter__(self) -> "_Writer":
         return self
 
+    def _write(self, *frame: Any) -> None:  # on the writing thread, one frame after the other
+        if self.failed:
+            return
+        try:
+            self.output.write(*frame)
+        except BaseException:
+            self.failed = True
+            raise
+
     def submit(self, *frame: Any) -> None:
         while self.pending and (len(self.pending) >= WRITE_BACKLOG or self.pending[0].done()):
             self.pending.popleft().result()  # a failed write stops the run at once
-        self.pending.append(self.pool.submit(self.output.write, *frame))
+        self.pending.append(self.pool.submit(self._write, *frame))
 
     def __exit__(self, *exc_info) -> None:
         self.pool.shutdown(wait=True)
