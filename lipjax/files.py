@@ -2,7 +2,7 @@
 
     done = complete_files("frame.png", "sparse.npy", "dense.npy", model="linear")          # one frame
     done = complete_files("rgb/", "sparse/", "dense/", depth_scale=1000, out_format="png")   # a folder of frames
-    print(done.summary())     # "wrote 100 frame(s) to dense in 12.3 s: 8.1 frames/s"
+    print(done.summary())     # "wrote 100 frame(s) to dense in 12.3 s: 8.13 frames/s"
     print(project_file("image.png", "sweep.bin", "calib.txt", "sparse.npy").summary())      # a LiDAR sweep
 
 Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
@@ -12,8 +12,9 @@ A folder runs at the model's own rate: worker threads read and decode the next f
 reads release the GIL) while the model runs on the current one in the calling thread, and one background thread
 post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is loaded
 once and compiled once per frame shape (jax.jit caches one executable per shape). Every output file is written
-under a temporary name beside it and renamed once whole, so a failing frame (an unreadable file, a full disk)
-leaves the frames before it written whole and nothing of itself or the frames after it.
+under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an
+unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the frames after
+it.
 """
 from __future__ import annotations
 
@@ -190,7 +191,7 @@ class Completed:
             wrote = f"{self.outputs[0]}" + (f" and {self.plys[0]}" if self.plys else "")
         else:
             wrote = f"{len(self.outputs)} frame(s) to {self.out} in {self.seconds:.1f} s"
-            notes.append(f"{len(self.outputs) / self.seconds:.1f} frames/s")
+            notes.append(f"{len(self.outputs) / self.seconds:.3g} frames/s")
         if self.unsupported:
             notes.append(f"{100 * self.unsupported:.1f} % of the pixels without support set to 0 (--fill-all keeps "
                          "them)")
@@ -205,20 +206,6 @@ def model_max_depth(completer: Any) -> float:
     return completer.config.max_depth_m if isinstance(completer, Completer) else SCENE_MAX_DEPTH_M["indoor"]
 
 
-@contextlib.contextmanager
-def written_whole(path: str | os.PathLike) -> Iterator[Path]:
-    """Yields a temporary path beside `path`, with its extension, and renames it to `path` once the block has
-    written it; on an error the temporary file is removed and `path` is left as it was."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    temporary = path.with_name(f".partial-{os.getpid()}-{path.name}")
-    try:
-        yield temporary
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-
-
 @dataclasses.dataclass
 class _Output:
     """The settings of the outputs, and what the writing thread learns while it writes (first frame's range,
@@ -229,7 +216,6 @@ class _Output:
     color_range: tuple[float, float] | None
     fill_all: bool
     max_uncertainty: float | None
-    intrinsics: Intrinsics | None = None
     max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
     fitted: bool = False
     unsupported: int = 0
@@ -241,8 +227,7 @@ class _Output:
         if job.uncertainty or self.max_uncertainty is not None:
             u = expected_error(sparse, dense)
             if job.uncertainty:
-                with written_whole(job.uncertainty) as path:
-                    write_uncertainty(path, u, self.max_uncertainty or 0.1 * self.max_depth_m)
+                write_uncertainty(job.uncertainty, u, self.max_uncertainty or 0.1 * self.max_depth_m)
             if self.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, self.max_uncertainty)
         if not self.fill_all:
@@ -252,11 +237,9 @@ class _Output:
             dense = masked
         if self.color_range is None:
             self.color_range, self.fitted = fitting_range(dense, self.max_depth_m), self.fmt == "color.png"
-        with written_whole(job.out) as path:
-            write_depth(path, dense, self.fmt, self.png_scale, self.color_range)
+        write_depth(job.out, dense, self.fmt, self.png_scale, self.color_range)
         if job.ply is not None:
-            with written_whole(job.ply) as path:
-                write_ply(path, *backproject_rgbd(dense, rgb, intrinsics))
+            write_ply(job.ply, *backproject_rgbd(dense, rgb, intrinsics))
 
 
 def prefetched(read: Callable[[Any], Any], items: Iterable[Any], workers: int = READ_WORKERS,
@@ -434,6 +417,5 @@ def project_file(rgb: str | os.PathLike, lidar: str | os.PathLike, calib: str | 
     farthest point)."""
     fmt = output_format(out)
     _, sparse, _ = read_lidar_frame(rgb, lidar, calib, camera)
-    with written_whole(out) as path:
-        write_depth(path, sparse, fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
+    write_depth(out, sparse, fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
     return Projected(Path(out), sparse)

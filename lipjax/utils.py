@@ -1,4 +1,5 @@
-"""Small process-level helpers: the persistent compilation cache, the CPU cores a process runs on."""
+"""Small process-level helpers: the persistent compilation cache, the CPU cores a process runs on, files written
+whole."""
 from __future__ import annotations
 
 import contextlib
@@ -6,6 +7,7 @@ import os
 import pathlib
 import sys
 import warnings
+from collections.abc import Iterator
 
 import jax
 
@@ -47,3 +49,18 @@ def limit_cpu_threads(n: int) -> set[int]:
         with contextlib.suppress(OSError):  # a thread that ended meanwhile
             os.sched_setaffinity(int(thread), cores)
     return cores
+
+
+@contextlib.contextmanager
+def written_whole(path: str | os.PathLike) -> Iterator[pathlib.Path]:
+    """Yields a temporary path beside `path` (parent folders created), ending like it (".npy", ".color.png": the
+    writers choose the format by it), and renames it to `path` once the block has written it. On an error or an
+    interrupt the temporary file is removed and `path` is left as it was: no reader ever sees half a file."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_name(f".partial-{os.getpid()}-{path.name}")
+    try:
+        yield temporary
+        os.replace(temporary, path)
+    finally:
+        temporary.unlink(missing_ok=True)

@@ -16,6 +16,7 @@ from lipjax import cli, files, model_io
 from lipjax.methods import get_completer
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
+from lipjax.utils import written_whole
 
 H, W = 24, 32
 SCALE = 256.0
@@ -71,7 +72,7 @@ def test_a_folder_writes_what_the_frames_one_by_one_write(model, tmp_path, fmt, 
     assert _complete(model, data / "rgb", data / "depth", tmp_path / "out", "--out-format", fmt,
                      "--ply", tmp_path / "ply", *INTRINSICS, *folder_extra) == 0
     summary = capsys.readouterr().err.strip().splitlines()[-1]
-    assert re.fullmatch(rf"wrote 4 frame\(s\) to {re.escape(str(tmp_path / 'out'))} in \d+\.\d s: \d+\.\d "
+    assert re.fullmatch(rf"wrote 4 frame\(s\) to {re.escape(str(tmp_path / 'out'))} in \d+\.\d s: [\d.]+ "
                         r"frames/s(; .*)?", summary), summary
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(f"{s}.{fmt}" for s in stems)
     for stem in stems:
@@ -143,31 +144,32 @@ def test_a_corrupt_frame_stops_the_folder_with_one_line_and_nothing_half_written
 
 
 def test_a_failing_write_stops_the_run_and_leaves_no_partial_file(tmp_path, monkeypatch):
-    """A write that fails half way (a full disk) leaves neither the file nor its temporary; earlier frames stay."""
+    """A write that fails half way (a full disk) leaves neither the file nor its temporary, and the frames queued
+    behind it are not written; the frames before it stay."""
     data = _frames(tmp_path / "in", ["0", "1", "2", "3"])
-    real, calls = files.write_depth, []
+    real, calls = cv2.imwrite, []
 
-    def disk_full_on_the_third(path, *args):
+    def disk_full_on_the_third(path, image, *args):
         calls.append(path)
         if len(calls) == 3:
             pathlib.Path(path).write_bytes(b"half a fi")
             raise OSError(28, "No space left on device")
-        real(path, *args)
+        return real(path, image, *args)
 
-    monkeypatch.setattr(files, "write_depth", disk_full_on_the_third)
+    monkeypatch.setattr(cv2, "imwrite", disk_full_on_the_third)
     with pytest.raises(OSError, match="No space left"):
         files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model="nearest",
                              progress=False)
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0.png", "1.png"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0.png", "1.png"] and len(calls) == 3
 
 
 def test_written_whole_keeps_the_old_file_when_a_write_fails(tmp_path):
     target = tmp_path / "sub" / "d.npy"
-    with files.written_whole(target) as path:
+    with written_whole(target) as path:
         assert path.parent == target.parent and path.name.endswith(".npy") and path != target
         np.save(path, np.ones(3, np.float32))
     with pytest.raises(RuntimeError):
-        with files.written_whole(target) as path:
+        with written_whole(target) as path:
             path.write_bytes(b"garbage")
             raise RuntimeError("interrupted")
     np.testing.assert_array_equal(np.load(target), np.ones(3, np.float32))
@@ -206,3 +208,12 @@ def test_limit_cpu_threads_pins_every_thread_and_sizes_xla_and_opencv():
     assert result.returncode == 0, result.stderr
     cores, cv_threads, affinities, eigen = result.stdout.split(" ", 3)
     assert (cores, cv_threads, affinities, int(eigen) <= 1) == ("1", "1", "[1]", True), result.stdout
+
+
+def test_the_summary_line_names_the_rate_the_masked_share_and_the_fitted_colours():
+    two = files.Completed([pathlib.Path("o/a.png"), pathlib.Path("o/b.png")], [], pathlib.Path("o"), 0.8, 0.25,
+                          (0.0, 42.0))
+    assert two.summary() == ("wrote 2 frame(s) to o in 0.8 s: 2.5 frames/s; 25.0 % of the pixels without support set "
+                             "to 0 (--fill-all keeps them); colours 0-42 m")
+    one = files.Completed([pathlib.Path("d.npy")], [pathlib.Path("c.ply")], pathlib.Path("d.npy"), 3.0, 0.0, None)
+    assert one.summary() == "wrote d.npy and c.ply"
