@@ -7,6 +7,12 @@
     result = evaluate(NearestFill(), source.dataset, source.sampler, min_depth_m=protocol.min_depth_m,
                       max_depth_m=protocol.max_depth_m)
 
+    report = evaluate_methods(["nearest", "lip-fast-indoor"], data="my_frames", max_depth_m=10)   # `lipjax evaluate`
+    print(report.header()); print(markdown_table(report.results))
+
+`open_eval_data` opens what `lipjax evaluate --data` or `--source` names (the synthetic scenes, a folder, a training
+source) in one place; `evaluate_methods` scores every method on it.
+
 Protocol, in one place:
   - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
     sample id and this seed, so every method sees the same inputs and reruns are identical;

@@ -46,7 +46,7 @@ import numpy as np
 from lipjax.inference import Completer
 from lipjax.methods import get_completer
 
-EXPORT_FORMATS = {".stablehlo": "serialised StableHLO (jax.export), which JAX runs"}
+EXPORT_FORMATS = {".stablehlo": "serialised StableHLO for jax.export, which JAX runs"}
 """The formats `export` writes, by the extension of its output file."""
 
 
@@ -138,8 +138,8 @@ def export_format(path: str | os.PathLike) -> str:
     suffix = pathlib.Path(path).suffix.lower()
     if suffix not in EXPORT_FORMATS:
         known = ", ".join(f"{ext} ({what})" for ext, what in EXPORT_FORMATS.items())
-        raise ValueError(f"--out {os.fspath(path)}: unknown export format {suffix or '(no extension)'!r}; the "
-                         f"extension chooses it: {known}. ONNX (.onnx) is not supported yet")
+        raise ValueError(f"--out {os.fspath(path)}: unknown export format {suffix or '(no extension)'!r}; give it "
+                         f"one of these extensions: {known}; ONNX (.onnx) is not supported yet")
     return suffix
 
 

@@ -310,22 +310,22 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
 
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
          max_side: int | None, progress: bool, log: Callable[[str], None] | None, workers: int) -> None:
-    """Reads (prefetched), completes (this thread) and writes (`_Writer`) every job of the plan, in order."""
-    bar = None
-    if progress and len(plan.jobs) > 1:
-        from tqdm import tqdm
+    """Reads (prefetched), completes (this thread) and writes (`_Writer`) every job of the plan, in order. The
+    model is loaded after the first frame is read (input errors come before the slow model load); the progress
+    bar starts after the line naming it."""
+    from tqdm import tqdm
 
-        bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr)
-    completer = None  # loaded after the first frame is read: input errors come before the slow model load
+    completer = bar = None
     try:
         with contextlib.closing(prefetched(read, plan.jobs, workers)) as frames, _Writer(output) as writer:
             for job, rgb, sparse, intrinsics in frames:
                 if completer is None:
                     completer = _load(model, iterations, sparse, job.rgb, max_side, log)
                     output.max_depth_m = model_max_depth(completer)
+                    bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
+                               disable=not progress or len(plan.jobs) < 2)
                 writer.submit(job, rgb, sparse, complete_frame(completer, rgb, sparse, max_side), intrinsics)
-                if bar is not None:
-                    bar.update()
+                bar.update()
     finally:
         if bar is not None:
             bar.close()
