@@ -6,6 +6,7 @@ import pathlib
 import re
 import subprocess
 import sys
+import threading
 
 import cv2
 import numpy as np
@@ -110,6 +111,40 @@ def test_frames_run_once_each_in_natural_order_while_the_next_are_read_ahead(tmp
     for i, stem in enumerate(stems):
         raw = cv2.imread(str(tmp_path / "out" / f"{stem}.png"), cv2.IMREAD_UNCHANGED)
         assert raw[0, 0] == (1 + i) * SCALE
+
+
+def test_reading_and_writing_overlap_the_model(tmp_path, monkeypatch):
+    """The next frame is read while the model runs, and a frame is written while the model runs on the next one:
+    the model waits on frame 0 until frame 1's read has begun, and frame 0's write waits until the model runs on
+    frame 1. A loop that reads, completes and writes in turn would wait forever (each wait fails after 10 s)."""
+    data = _frames(tmp_path / "in", ["0", "1", "2"])
+    reading_1, model_on_1 = threading.Event(), threading.Event()
+    real_read, real_write = files.read_frame, files.write_depth
+
+    def read(rgb, depth, scale):
+        if pathlib.Path(rgb).stem == "1":
+            reading_1.set()
+        return real_read(rgb, depth, scale)
+
+    def write(path, *args):
+        if pathlib.Path(path).stem == "0":
+            assert model_on_1.wait(10), "frame 0 was written before the model ran on frame 1"
+        real_write(path, *args)
+
+    class Waiting(_Recording):
+        def __call__(self, rgb, sparse):
+            if sparse[0, 0] == 1:
+                assert reading_1.wait(10), "frame 1 was not read while the model ran on frame 0"
+            if sparse[0, 0] == 2:
+                model_on_1.set()
+            return super().__call__(rgb, sparse)
+
+    monkeypatch.setattr(files, "read_frame", read)
+    monkeypatch.setattr(files, "write_depth", write)
+    model = Waiting()
+    files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model=model,
+                         progress=False)
+    assert model.seen == [1.0, 2.0, 3.0] and len(list((tmp_path / "out").iterdir())) == 3
 
 
 def test_prefetched_keeps_the_order_and_raises_an_error_in_its_turn():
