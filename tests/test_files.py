@@ -14,6 +14,7 @@ import pytest
 
 import lipjax
 from lipjax import cli, files, model_io
+from lipjax.inference import compiled_apply
 from lipjax.methods import get_completer
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
@@ -65,13 +66,17 @@ def _complete(model, rgb, depth, out, *extra):
 @pytest.mark.parametrize("fmt, extra", [("png", ["--uncertainty", "U"]),
                                         ("color.png", ["--color-range", "0", "6", "--max-uncertainty", "0.5"])])
 def test_a_folder_writes_what_the_frames_one_by_one_write(model, tmp_path, fmt, extra, capsys):
-    """Every file of a folder run (depth, PLY, uncertainty) is byte for byte the one-frame command's, and the
-    summary line gives the number of frames, the time and frames/s."""
+    """Every file of a folder run (depth, PLY, uncertainty) is byte for byte the one-frame command's, the model
+    compiles once for the frames' one shape, and the summary line gives the number of frames, the time and
+    frames/s."""
     stems = ["0", "1", "2", "10"]
     data = _frames(tmp_path / "in", stems)
     folder_extra = [a if a != "U" else tmp_path / "unc" for a in extra]
+    assert lipjax.load_model(model).config == CONFIG  # so the model file runs the jitted function of CONFIG
+    compiled = compiled_apply(CONFIG, False)._cache_size()
     assert _complete(model, data / "rgb", data / "depth", tmp_path / "out", "--out-format", fmt,
                      "--ply", tmp_path / "ply", *INTRINSICS, *folder_extra) == 0
+    assert compiled_apply(CONFIG, False)._cache_size() <= compiled + 1  # four frames of one shape: one compilation
     summary = capsys.readouterr().err.strip().splitlines()[-1]
     assert re.fullmatch(rf"wrote 4 frame\(s\) to {re.escape(str(tmp_path / 'out'))} in \d+\.\d s: [\d.]+ "
                         r"frames/s(; .*)?", summary), summary
