@@ -7,6 +7,12 @@
     result = evaluate(NearestFill(), source.dataset, source.sampler, min_depth_m=protocol.min_depth_m,
                       max_depth_m=protocol.max_depth_m)
 
+    report = evaluate_methods(["nearest", "lip-fast-indoor"], data="my_frames", max_depth_m=10)   # `lipjax evaluate`
+    print(report.header()); print(markdown_table(report.results))
+
+`open_eval_data` opens what `lipjax evaluate --data` or `--source` names (the synthetic scenes, a folder, a training
+source) in one place; `evaluate_methods` scores every method on it.
+
 Protocol, in one place:
   - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
     sample id and this seed, so every method sees the same inputs and reruns are identical;
@@ -35,7 +41,8 @@ import numpy as np
 from lipjax.classical.completer import DepthCompleter
 from lipjax.data.protocols import Protocol
 from lipjax.data.sample import Sample
-from lipjax.data.sources import Source, open_source, range_protocol
+from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol
+from lipjax.methods import get_completer
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 
 Sampler = Callable[[Sample, int], np.ndarray]  # (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample
@@ -168,7 +175,7 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
     from lipjax.data.errors import dataset_error
     from lipjax.data.folder import FolderDataset
     from lipjax.data.sampling import sampler_from_spec
-    from lipjax.data.sources import (OWN_INPUT, VAL_TAIL_FRACTION, FolderInput, Subset, folder_split_root, own_points,
+    from lipjax.data.sources import (VAL_TAIL_FRACTION, FolderInput, Subset, folder_split_root, own_points,
                                      tail_split, uses_intrinsics)
 
     if split not in (None, "train", "val"):
@@ -197,6 +204,105 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
     share = tail if split == "val" else f"all but {tail}"
     return (Subset(dataset, tail_split(["all"] * len(dataset), split)), draw, spec,
             f"{split} split: {share} of the frames, as lipjax train holds them out")
+
+
+@dataclasses.dataclass(frozen=True)
+class EvalData:
+    """Frames to evaluate on, as `open_eval_data` opens them.
+
+    Attributes:
+      dataset: an indexable of Samples, the protocol applied. sampler: (sample, seed) -> sparse (H, W) metres.
+      spec: the sampler's spec. name: the data in words. range_from: the protocol whose depth range is evaluated,
+        or None (a folder, frames as they are: the caller gives the range).
+    """
+
+    dataset: Any
+    sampler: Sampler
+    spec: str
+    name: str
+    range_from: Protocol | None
+
+
+def _check_eval_args(data: str | None, source: str | None, root, raw_root, split, kind, size, intrinsics) -> None:
+    """The combinations of open_eval_data's arguments that mean nothing (errors name `lipjax evaluate`'s flags)."""
+    if source is None and (root is not None or raw_root is not None):
+        raise ValueError("--root and --raw-root go with --source NAME; --data takes the folder itself")
+    if kind is not None and source != "synthetic":
+        raise ValueError(f"--kind goes with --source synthetic; --source rendered reads the kind from the render's "
+                         f"index.json, and --data synthetic-{kind} names it itself")
+    if source is None:
+        return
+    if data is not None:
+        raise ValueError("--data and --source name the frames twice; give one")
+    if root is None and source != "synthetic":
+        raise ValueError(f"--source {source} needs --root DIR, the folder holding the data set")
+    if size is not None:
+        raise ValueError(f"--size is for --data synthetic-*; --source {source} reads its frames at their own "
+                         "(training) size")
+    if intrinsics is not None:
+        raise ValueError(f"--intrinsics / --intrinsics-file are for --data FOLDER; --source {source} reads the data "
+                         "set's own")
+    if split not in (None, "train", "val"):
+        raise ValueError(f"--split {split}: with --source, the split is train or val")
+    if source == "rendered" and split is not None:
+        raise ValueError("--split: --source rendered evaluates the frames in --root (their split is the render's); "
+                         "drop --split")
+
+
+def open_eval_data(data: str | None = None, source: str | None = None, *, root: str | os.PathLike | None = None,
+                   raw_root: str | os.PathLike | None = None, split: str | None = None, kind: str | None = None,
+                   size: tuple[int, int] | None = None, sampler: str | None = None, protocol: str | None = None,
+                   depth_scale: float | None = None, intrinsics: Any = None) -> EvalData:
+    """The frames `lipjax evaluate` scores, named by `--data` or by `--source` (these parameters are its flags).
+
+    Args:
+      data: "synthetic-indoor" (the default when `source` is None) or "synthetic-outdoor": the synthetic `split`
+        (default test) at `size` (H, W); or a FOLDER (lipjax.data.folder layout; `open_folder`, with `intrinsics`:
+        (fx, fy, cx, cy), K or a file, pixels). The named `protocol` (or none) is applied to the frames.
+      source, root, raw_root, kind: a training data source read as training reads it (`open_eval_source`), split
+        train or val (default val).
+      sampler: a lipjax.data.sampling spec or "input[:N]" (default: a FOLDER's own sparse/, else DEFAULT_SAMPLER).
+      depth_scale: PNG value per metre of the folder's depth.
+
+    Raises ValueError with a one-line message for arguments that do not go together or data that are not there.
+    """
+    from lipjax.data.folder import read_intrinsics
+    from lipjax.data.protocols import ProtocolView, get_protocol
+    from lipjax.data.rendered import RenderedMixture, open_rendered
+    from lipjax.data.sources import NO_PROTOCOL
+
+    _check_eval_args(data, source, root, raw_root, split, kind, size, intrinsics)
+    if source is not None:
+        split, spec = split or "val", sampler or DEFAULT_SAMPLER
+        opened, range_from = open_eval_source(source, root, split, sampler=spec, protocol=protocol,
+                                              raw_root=raw_root, depth_scale=depth_scale, kind=kind)
+        if source == "rendered":
+            render = open_rendered(root)
+            parts = render.parts if isinstance(render, RenderedMixture) else [render]
+            name = f"rendered {' + '.join(f'{p.kind}/{p.split}' for p in parts)} ({root})"
+        else:
+            scene = f" {kind or 'indoor'}" if source == "synthetic" else ""
+            name = f"{source}{scene} {split}" + (f" ({root})" if root else "")
+        return EvalData(opened.dataset, opened.sampler, spec, name, range_from)
+    data = data or "synthetic-indoor"
+    named = get_protocol(protocol) if protocol not in (None, NO_PROTOCOL) else None
+    if data in ("synthetic-indoor", "synthetic-outdoor"):
+        from lipjax.data.sampling import sampler_from_spec
+        from lipjax.data.synthetic import SyntheticDataset
+
+        scene, spec = data.split("-")[1], sampler or DEFAULT_SAMPLER
+        dataset = SyntheticDataset(scene, split or "test", **({"height": size[0], "width": size[1]} if size else {}))
+        draw, name, range_from = sampler_from_spec(spec), data, named or get_protocol(f"synthetic_{scene}")
+    else:
+        if not Path(data).is_dir():
+            raise ValueError(f"--data {data}: not synthetic-indoor, synthetic-outdoor or a folder")
+        if split == "test":
+            raise ValueError(f"--split test: a folder has train and val frames (--split train|val), or leave --split "
+                             f"out to score every frame of {data}")
+        dataset, draw, spec, which = open_folder(data, split, sampler=sampler, depth_scale=depth_scale,
+                                                 intrinsics=read_intrinsics(intrinsics))
+        name, range_from = f"{data}, {which}", named
+    return EvalData(ProtocolView(dataset, named) if named else dataset, draw, spec, name, range_from)
 
 
 def evaluate(
@@ -270,6 +376,55 @@ def evaluate(
         min_depth_m=float(min_depth_m),
         max_depth_m=float(max_depth_m),
     )
+
+
+@dataclasses.dataclass(frozen=True)
+class Evaluation:
+    """The results of several methods on one EvalData over one depth range (metres): `lipjax evaluate`'s table."""
+
+    results: dict[str, EvalResult]
+    data: EvalData
+    min_depth_m: float
+    max_depth_m: float
+
+    def header(self) -> str:
+        """One line: the data, the number of frames, the sparse input and the depth range."""
+        n = next(iter(self.results.values())).num_images
+        own = " (the data's own sparse maps)" if self.data.spec.split(":")[0] == OWN_INPUT else ""
+        return (f"data: {self.data.name} ({n} frames), sampler: {self.data.spec}{own}, depth range: "
+                f"({self.min_depth_m:g}, {self.max_depth_m:g}] m")
+
+
+def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | None = None,
+                     min_depth_m: float | None = None, max_depth_m: float | None = None, limit: int | None = None,
+                     seed: int = 0, progress: bool = True, **data: Any) -> Evaluation:
+    """Opens the frames (`open_eval_data(**data)`) and `evaluate`s every model on them, in order.
+
+    Args:
+      models: what lipjax.methods.get_completer takes (names, paths, objects), each labelled by its name; None
+        or empty: the default model of the first frame's input, labelled by its name ("untrained" for the
+        untrained stand-in).
+      iterations: run LIP models' first K iterations.
+      min_depth_m, max_depth_m: the evaluated ground-truth range (min, max] metres; by default the data's range
+        protocol's (a folder without --protocol has none: then max_depth_m is required).
+      limit, seed, progress: as `evaluate` takes them.
+    """
+    frames = open_eval_data(**data)
+    protocol = frames.range_from
+    min_depth = min_depth_m if min_depth_m is not None else (protocol.min_depth_m if protocol else 0.0)
+    max_depth = max_depth_m if max_depth_m is not None else (protocol.max_depth_m if protocol else None)
+    if max_depth is None:
+        raise ValueError("give the evaluated depth range: --max-depth-m M (e.g. 10 indoors, 80 outdoors) "
+                         "or --protocol NAME")
+    results = {}
+    for model in models or [None]:
+        first = None if model is not None else frames.sampler(frames.dataset[0], seed)
+        completer = get_completer(model, iterations, sparse=first)
+        label = (os.fspath(model) if isinstance(model, (str, os.PathLike))
+                 else "untrained" if completer.name == "random" else completer.name)
+        results[label] = evaluate(completer, frames.dataset, frames.sampler, min_depth_m=min_depth,
+                                  max_depth_m=max_depth, limit=limit, progress=progress, seed=seed)
+    return Evaluation(results, frames, min_depth, max_depth)
 
 
 def _fmt(column: str, value: float | None) -> str:

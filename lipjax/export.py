@@ -5,7 +5,9 @@
     run = load_exported("lip-ad-indoor_1x480x640.stablehlo")
     depth = run(rgb_uint8_bhw3, sparse_f32_bhw)                        # (B, H, W) float32 metres
 
-or from the shell: `lipjax export --model lip-ad-indoor --height 480 --width 640 --out model.stablehlo`.
+or from the shell: `lipjax export --model lip-ad-indoor --height 480 --width 640 --out model.stablehlo`, which runs
+`export(model, out, height=..., width=...)`: the extension of `out` chooses the format (EXPORT_FORMATS; .stablehlo
+only so far, anything else is an error before the model loads).
 
 Choices:
   - The parameters are baked into the program as constants, so the file is the whole model: nothing else to
@@ -42,6 +44,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.inference import Completer
+from lipjax.methods import get_completer
+
+EXPORT_FORMATS = {".stablehlo": "serialised StableHLO for jax.export, which JAX runs"}
+"""The formats `export` writes, by the extension of its output file."""
 
 
 def export_completer(completer: Completer, batch: int, height: int, width: int,
@@ -125,3 +131,49 @@ def load_exported(path: str | os.PathLike) -> ExportedCompleter:
         raise ValueError(f"{os.fspath(path)!r} is not a jax.export file this jax can read "
                          f"({type(exc).__name__}: {exc})") from exc
     return ExportedCompleter(exported)
+
+
+def export_format(path: str | os.PathLike) -> str:
+    """The extension of `path` when it names a format of EXPORT_FORMATS; ValueError naming them otherwise."""
+    suffix = pathlib.Path(path).suffix.lower()
+    if suffix not in EXPORT_FORMATS:
+        known = ", ".join(f"{ext} ({what})" for ext, what in EXPORT_FORMATS.items())
+        raise ValueError(f"--out {os.fspath(path)}: unknown export format {suffix or '(no extension)'!r}; give it "
+                         f"one of these extensions: {known}; ONNX (.onnx) is not supported yet")
+    return suffix
+
+
+@dataclasses.dataclass(frozen=True)
+class ExportedFile:
+    """What `export` wrote: the file, the exported program, and the model's host-side initial fill ("linear",
+    "nearest"), which the program then takes as a third input z0; None when it takes two inputs."""
+
+    path: pathlib.Path
+    exported: jax.export.Exported
+    host_fill: str | None
+
+    def summary(self) -> str:
+        """One line: the file, its size and the program's signature (shapes, dtypes, metres) and platforms."""
+        shape = tuple(int(d) for d in self.exported.in_avals[1].shape)
+        z0 = (f", z0 float32 {shape} m (the model's {self.host_fill} fill of sparse, computed outside: "
+              "lipjax.model.host_initial_estimate)") if self.host_fill else ""
+        return (f"wrote {self.path} ({self.path.stat().st_size} bytes): rgb uint8 {shape + (3,)}, sparse float32 "
+                f"{shape} m{z0} -> depth m; platforms {list(self.exported.platforms)}")
+
+
+def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
+           platforms: Sequence[str] | None = None) -> ExportedFile:
+    """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
+    (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`).
+
+    Raises ValueError for an unknown extension or a hand-crafted fill (nothing learned to export), ImportError
+    without the flatbuffers package; all before the model loads."""
+    export_format(out)
+    _need_flatbuffers()
+    completer = get_completer(model, iterations)
+    if not isinstance(completer, Completer):
+        raise ValueError(f"--model {completer.name}: a hand-crafted fill has no learned model to export; export a "
+                         "shipped model (lipjax models) or a saved model path")
+    exported = export_completer(completer, batch, height, width, platforms=platforms)
+    path = save_exported(exported, out)
+    return ExportedFile(path, exported, completer.config.initial_estimate if len(exported.in_avals) == 3 else None)

@@ -23,7 +23,7 @@ import numpy as np
 from lipjax.interfaces import MODEL_TYPES, model_type_name
 from lipjax.model import LIPConfig
 from lipjax.priors.network import NetworkPrior
-from lipjax.shipped import WEIGHTS_DIR, available
+from lipjax.shipped import DEFAULT_MODELS, WEIGHTS_DIR, available
 
 
 class ModelFileError(ValueError):
@@ -151,6 +151,17 @@ def table(defaults: dict[str, str]) -> str:
                      f"{meta['images_seen']:,} images" if "images_seen" in meta else "-"))
     widths = [max(len(r[i]) for r in rows) for i in range(len(TABLE_COLUMNS))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def listing() -> str:
+    """What `lipjax models` prints: the `table` of the shipped models (their defaults marked) and its legend, or
+    where to get a model when none is shipped."""
+    if not available():
+        return (f"no shipped models in {WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. Train one "
+                "with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
+    return (table(DEFAULT_MODELS) + "\n\nDEFAULT: lipjax complete picks the indoor default for scattered samples, "
+            "the outdoor default for LiDAR scan lines\nor a median sample depth over 12 m; --model NAME overrides "
+            "it. TYPE: LIP and its prox, or an end-to-end network.")
 
 
 def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:

@@ -18,6 +18,7 @@ import pathlib
 import numpy as np
 
 from lipjax.data.sample import Intrinsics
+from lipjax.utils import written_whole
 from lipjax.zbuffer import splat_nearest
 
 IntrinsicsLike = Intrinsics | np.ndarray
@@ -78,7 +79,8 @@ def write_ply(path: str | os.PathLike, points: np.ndarray, colors: np.ndarray | 
               binary: bool = True) -> None:
     """Writes a PLY point cloud: float32 x y z (metres) and optional uchar red green blue per vertex.
 
-    Binary little-endian by default (compact; MeshLab, CloudCompare, Open3D, Blender read it), or ASCII.
+    Binary little-endian by default (compact; MeshLab, CloudCompare, Open3D, Blender read it), or ASCII. The
+    file appears whole or not at all (lipjax.utils.written_whole).
     """
     points = np.asarray(points, dtype=np.float32)
     if points.ndim != 2 or points.shape[1] != 3:
@@ -101,8 +103,7 @@ def write_ply(path: str | os.PathLike, points: np.ndarray, colors: np.ndarray | 
     vertices["x"], vertices["y"], vertices["z"] = points.T
     if colors is not None:
         vertices["red"], vertices["green"], vertices["blue"] = colors.T
-    path = pathlib.Path(path)
-    with open(path, "wb") as f:
+    with written_whole(path) as temporary, open(temporary, "wb") as f:
         f.write(("\n".join(header) + "\n").encode("ascii"))
         if binary:
             f.write(vertices.tobytes())

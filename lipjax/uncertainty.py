@@ -38,6 +38,8 @@ from pathlib import Path
 import numpy as np
 from scipy import ndimage
 
+from lipjax.utils import written_whole
+
 SPREAD_GAIN = 0.1217
 """Expected |error| per metre of nearby sample depth spread and per spacing of distance (dimensionless)."""
 ABOVE_GAIN = 0.1613
@@ -143,16 +145,16 @@ def mask_unsupported(depth: np.ndarray, sparse: np.ndarray) -> np.ndarray:
 
 def write_uncertainty(path: str | os.PathLike, uncertainty: np.ndarray, max_m: float) -> None:
     """Writes (H, W) expected error (metres): X.npy as float32 metres; X.png as a colour picture (the error-map
-    colours of lipjax.viz: dark blue 0 m to dark red >= max_m metres)."""
+    colours of lipjax.viz: dark blue 0 m to dark red >= max_m metres), whole or not at all."""
     from lipjax import viz
 
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     suffix = path.suffix.lower()
-    if suffix == ".npy":
-        np.save(path, np.asarray(uncertainty, np.float32))
-    elif suffix == ".png":
-        u = np.asarray(uncertainty, np.float32)
-        viz.write_png(path, viz.error_map(u, np.zeros_like(u), np.ones(u.shape, bool), max_error_m=max_m))
-    else:
+    if suffix not in (".npy", ".png"):
         raise ValueError(f"{path}: unknown uncertainty format {suffix!r}; use .npy (metres) or .png (picture)")
+    u = np.asarray(uncertainty, np.float32)
+    with written_whole(path) as temporary:
+        if suffix == ".npy":
+            np.save(temporary, u)
+        else:
+            viz.write_png(temporary, viz.error_map(u, np.zeros_like(u), np.ones(u.shape, bool), max_error_m=max_m))

@@ -101,3 +101,41 @@ def test_markdown_table_and_json(tmp_path):
     assert loaded["nearest"]["metrics"]["mae_m"] == pytest.approx(res.metrics["mae_m"])
     assert loaded["broken"]["metrics"]["rmse_m"] is None
     assert len(loaded["nearest"]["per_image"]) == 2
+
+
+def test_data_and_sources_open_through_one_function(tmp_path):
+    """open_eval_data: `--data synthetic-*` and `--source synthetic` give the same scenes' depth range, each
+    named; arguments that do not go together are one-line errors before anything is read."""
+    from lipjax.evaluate import open_eval_data
+
+    data = open_eval_data("synthetic-outdoor", size=(16, 24), sampler="uniform:20")
+    assert (data.name, data.spec, data.range_from.name) == ("synthetic-outdoor", "uniform:20", "synthetic_outdoor")
+    assert data.dataset[0].rgb.shape == (16, 24, 3) and (data.sampler(data.dataset[0], 0) > 0).sum() == 20
+    source = open_eval_data(source="synthetic", kind="outdoor")
+    assert (source.name, source.spec) == ("synthetic outdoor val", "uniform:200")
+    assert source.range_from.max_depth_m == data.range_from.max_depth_m
+    for kwargs, message in [({"root": tmp_path}, "--root and --raw-root go with --source NAME"),
+                            ({"data": "synthetic-indoor", "source": "synthetic"}, "--data and --source name"),
+                            ({"source": "nyu_h5"}, "--source nyu_h5 needs --root DIR"),
+                            ({"data": str(tmp_path / "none")}, "not synthetic-indoor, synthetic-outdoor or a folder"),
+                            ({"data": str(tmp_path), "split": "test"}, "--split test: a folder has train and val")]:
+        with pytest.raises(ValueError, match=message):
+            open_eval_data(**kwargs)
+
+
+def test_evaluate_methods_scores_each_model_over_the_data_range(tmp_path):
+    import cv2
+
+    from lipjax.evaluate import evaluate_methods
+
+    report = evaluate_methods(["nearest", "linear"], data="synthetic-indoor", size=(16, 24), sampler="uniform:30",
+                              limit=2, progress=False)
+    assert list(report.results) == ["nearest", "linear"] and report.max_depth_m == 10.0
+    assert all(r.num_images == 2 and r.max_depth_m == 10.0 for r in report.results.values())
+    assert report.header() == "data: synthetic-indoor (2 frames), sampler: uniform:30, depth range: (0, 10] m"
+    for sub in ("rgb", "depth"):  # a folder of the user's frames has no depth range of its own
+        (tmp_path / sub).mkdir()
+    cv2.imwrite(str(tmp_path / "rgb" / "0.png"), np.zeros((H, W, 3), np.uint8))
+    np.save(tmp_path / "depth" / "0.npy", np.ones((H, W), np.float32))
+    with pytest.raises(ValueError, match="give the evaluated depth range: --max-depth-m M"):
+        evaluate_methods(["nearest"], data=str(tmp_path), progress=False)

@@ -101,3 +101,32 @@ def test_host_initial_estimate_model_exports_with_a_z0_input(tmp_path):
     with pytest.raises(ValueError, match="z0"):
         run(rgb, sparse)
     assert not dataclasses.replace(c.config, initial_estimate="box_fill").needs_host_initial_estimate
+
+
+@pytest.mark.parametrize("name", ["m.onnx", "m.ONNX", "m", "m.stablehlo.txt"])
+def test_export_command_takes_its_format_from_the_extension_and_refuses_others(name, tmp_path, capsys):
+    """An unknown extension is one line naming the supported formats, before the model is looked up (the model
+    named here does not exist) and without writing anything."""
+    from lipjax import cli
+
+    rc = cli.main(["export", "--model", "no-such-model", "--height", "8", "--width", "8", "--out",
+                   str(tmp_path / name)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert rc == 1 and len(lines) == 1 and lines[0].startswith(f"lipjax: error: --out {tmp_path / name}: unknown "
+                                                               "export format"), lines
+    assert ".stablehlo (serialised StableHLO" in lines[0] and "ONNX (.onnx) is not supported yet" in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_writes_the_model_and_a_summary_and_refuses_a_hand_crafted_fill(completer, tmp_path):
+    from lipjax.export import export
+
+    done = export(completer, tmp_path / "x" / "m.StableHLO", height=H, width=W)
+    assert done.path == tmp_path / "x" / "m.StableHLO" and done.host_fill is None
+    rgb, sparse = _inputs()
+    np.testing.assert_allclose(load_exported(done.path)(rgb[:1], sparse[:1]), completer(rgb[:1], sparse[:1]),
+                               rtol=1e-5, atol=1e-5)
+    assert done.summary() == (f"wrote {done.path} ({done.path.stat().st_size} bytes): rgb uint8 (1, {H}, {W}, 3), "
+                              f"sparse float32 (1, {H}, {W}) m -> depth m; platforms {list(done.exported.platforms)}")
+    with pytest.raises(ValueError, match="--model linear: a hand-crafted fill has no learned model to export"):
+        export("linear", tmp_path / "l.stablehlo", height=H, width=W)

@@ -27,7 +27,8 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.sample import Intrinsics, Sample
-from lipjax.pointcloud import as_intrinsics
+from lipjax.pointcloud import IntrinsicsLike, as_intrinsics
+from lipjax.utils import written_whole
 
 RGB_SUFFIXES = (".png", ".jpg", ".jpeg")
 DEPTH_SUFFIXES = (".png", ".npy")
@@ -43,6 +44,20 @@ FOLDER_SOURCE = "your own frames (lipjax.data.folder.FolderDataset)"
 _DIGITS = re.compile(r"(\d+)")
 # Stands in for the intrinsics of a folder without any, where nothing reads them (FolderDataset).
 UNUSED_INTRINSICS = Intrinsics(1.0, 1.0, 0.0, 0.0)
+
+
+def parse_depth_scale(text: str) -> float:
+    """A PNG depth value per metre (> 0) from a number or a sensor's name in KNOWN_DEPTH_SCALES (kitti, nyu,
+    tum); ValueError otherwise."""
+    if text.lower() in KNOWN_DEPTH_SCALES:
+        return KNOWN_DEPTH_SCALES[text.lower()]
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"expected a number or one of {sorted(KNOWN_DEPTH_SCALES)}, got {text!r}") from None
+    if not value > 0:
+        raise ValueError(f"must be > 0, got {text}")
+    return value
 
 
 def natural_key(text: str) -> tuple:
@@ -149,6 +164,16 @@ def read_intrinsics_txt(path: str | os.PathLike, camera: int = 2) -> Intrinsics:
         raise dataset_error(str(exc), path) from exc
 
 
+def read_intrinsics(intrinsics: IntrinsicsLike | str | os.PathLike | None, camera: int = 2) -> Intrinsics | None:
+    """Checked Intrinsics (pixels) from an Intrinsics, (fx, fy, cx, cy) or a 3x3 K (lipjax.pointcloud.as_intrinsics),
+    or from a file `read_intrinsics_txt` reads (KITTI camera `camera` of a calibration file); None stays None."""
+    if intrinsics is None:
+        return None
+    if isinstance(intrinsics, (str, os.PathLike)):
+        return read_intrinsics_txt(intrinsics, camera)
+    return as_intrinsics(intrinsics)
+
+
 def read_frame(rgb_path: str | os.PathLike, depth_path: str | os.PathLike,
                scale: float | None) -> tuple[np.ndarray, np.ndarray]:
     """(rgb (H, W, 3) uint8, sparse (H, W) float32 metres) of one frame, checked: the depth is a .npy (metres)
@@ -186,24 +211,24 @@ def output_format(path: str | os.PathLike) -> str:
 def write_depth(path: str | os.PathLike, dense_m: np.ndarray, fmt: str, png_scale: float,
                 color_range_m: tuple[float, float]) -> None:
     """Writes (H, W) metres as fmt: "npy" (float32 metres), "png" (16-bit, value = round(metres * png_scale);
-    depths that do not fit are clipped, with a warning) or "color.png" (turbo picture over color_range_m)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    if fmt == "npy":
-        np.save(path, np.asarray(dense_m, np.float32))
-    elif fmt == "color.png":
-        from lipjax import viz
-
-        viz.write_png(path, viz.colorize_depth(dense_m, *color_range_m))
-    elif fmt == "png":
-        raw = np.round(np.asarray(dense_m, np.float64) * png_scale)
-        if raw.max() > 65535:
-            warnings.warn(f"{path}: depth above {65535 / png_scale:.1f} m does not fit a 16-bit PNG at scale "
-                          f"{png_scale:g}; clipped (use a smaller --depth-scale or .npy)", stacklevel=2)
-        if not cv2.imwrite(os.fspath(path), np.clip(raw, 0, 65535).astype(np.uint16)):
-            raise OSError(f"cannot write {path}")
-    else:
+    depths that do not fit are clipped, with a warning) or "color.png" (turbo picture over color_range_m). The
+    file appears whole or not at all (lipjax.utils.written_whole)."""
+    if fmt not in OUT_FORMATS:
         raise ValueError(f"unknown depth output format {fmt!r}; one of {OUT_FORMATS}")
+    with written_whole(path) as temporary:
+        if fmt == "npy":
+            np.save(temporary, np.asarray(dense_m, np.float32))
+        elif fmt == "color.png":
+            from lipjax import viz
+
+            viz.write_png(temporary, viz.colorize_depth(dense_m, *color_range_m))
+        else:
+            raw = np.round(np.asarray(dense_m, np.float64) * png_scale)
+            if raw.max() > 65535:
+                warnings.warn(f"{path}: depth above {65535 / png_scale:.1f} m does not fit a 16-bit PNG at scale "
+                              f"{png_scale:g}; clipped (use a smaller --depth-scale or .npy)", stacklevel=3)
+            if not cv2.imwrite(os.fspath(temporary), np.clip(raw, 0, 65535).astype(np.uint16)):
+                raise OSError(f"cannot write {path}")
 
 
 def check_one_depth_format(depth_paths: list[Path]) -> None:

@@ -183,11 +183,12 @@ class _Progress:
             self.log.write(json.dumps({"step": done, "phase": phase, "images_per_s": rate, **metrics}) + "\n")
             self.log.flush()
 
-    def validation(self, done: int, vm: dict) -> None:
+    def validation(self, done: int, vm: dict, note: str = "") -> None:
+        """Logs the validation metrics `vm` (metres) of step `done`; `note` follows the step in the printed line."""
         if self.log:
             self.log.write(json.dumps({"step": done, "split": "val", **vm}) + "\n")
             self.log.flush()
-            self.bar.write(f"[lipjax] step {done} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
+            self.bar.write(f"[lipjax] step {done}{note} val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
 
     def close(self) -> None:
         self.bar.close()
@@ -234,11 +235,7 @@ def train(
     shown = _Progress(config, workdir, start, end, progress, is_main)
     step = start
     if val and validate_start and start == 0:
-        vm = evaluate_params(config.model, state.g_params, val, max_depth)
-        if log:
-            log.write(json.dumps({"step": 0, "split": "val", **vm}) + "\n")
-            log.flush()
-            bar.write(f"[lipjax] step 0 (start) val rmse_m={vm['rmse_m']:.4f} mae_m={vm['mae_m']:.4f}")
+        shown.validation(0, evaluate_params(config.model, state.g_params, val, config.model.max_depth_m), " (start)")
     try:
         with _signals_as_exit(save_first=process_count == 1) as stop, loader:
             for step in range(start, end):

@@ -1,16 +1,20 @@
 """A whole training run as one call: train (or resume) in a workdir, validate, plot, export only where asked.
 
     run(config, "runs/lip_cnn_nyu", export="runs/lip_cnn_nyu/model")
+    fine_tune_folder("my_frames", "models/mine", depth_scale=1000)   # `lipjax train`: the default model, fine-tuned
 
-Used by `python -m experiments.train` and `lipjax train`. Nothing is written outside `workdir` and `export`.
+Used by `python -m experiments.train` and (through `fine_tune_folder`) `lipjax train`. Nothing is written outside
+`workdir` and `export`.
 """
 from __future__ import annotations
 
+import dataclasses
 import errno
 import json
 import os
 import pathlib
 import tempfile
+from collections.abc import Callable
 from typing import Any
 
 import jax
@@ -20,7 +24,7 @@ from lipjax import model_io
 from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
-from lipjax.train.folder import check_frames
+from lipjax.train.folder import check_frames, default_init, folder_config
 from lipjax.train.loop import evaluate_params, export as export_model, train, validation_batches
 from lipjax.train.state import init_state
 
@@ -120,3 +124,30 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f}{before} "
               "(nothing exported; add --export PATH)")
     return val
+
+
+def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str | None = None,
+                     steps: int | None = None, batch_size: int = 8, workdir: str | os.PathLike | None = None,
+                     progress: bool = True, log: Callable[[str], None] | None = None, **data: Any) -> dict:
+    """`lipjax train`: fine-tunes a model on a folder of RGB-D frames (lipjax.train.folder) and exports it to
+    `out` (a model path stem, also the run's name).
+
+    Args:
+      init: the model to start from (name or path); None: the default model of the frames' scene
+        (lipjax.train.folder.default_init), named with its reason to `log` (a callable taking a line) if given.
+      steps: training steps (default folder_config's 2000). batch_size: frames per step.
+      workdir: checkpoints and logs (default runs/train-<out name>).
+      data: DataConfig fields over lipjax.train.folder.FOLDER_DATA (depth_scale, crop, train_sampler, num_workers);
+        None keeps FOLDER_DATA's.
+
+    Returns the validation metrics (metres), as `run`.
+    """
+    data = {"root": os.fspath(root), **{k: v for k, v in data.items() if v is not None}}
+    if init is None:
+        init, scene, why = default_init(**data)
+        if log is not None:
+            log(f"init: {init}, the default for {scene} input ({why}); choose another with --init")
+    name = pathlib.Path(out).name
+    config = folder_config(model_io.load(init)[0], init, name=name, **data)
+    config = dataclasses.replace(config, batch_size=batch_size, **({"g_steps": steps} if steps else {}))
+    return run(config, workdir or f"runs/train-{name}", export=out, progress=progress, validate_start=True)

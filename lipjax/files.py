@@ -1,0 +1,421 @@
+"""Models run over files and folders on disk: what `lipjax complete` and `lipjax project` do.
+
+    done = complete_files("frame.png", "sparse.npy", "dense.npy", model="linear")          # one frame
+    done = complete_files("rgb/", "sparse/", "dense/", depth_scale=1000, out_format="png")   # a folder of frames
+    print(done.summary())     # "wrote 100 frame(s) to dense in 12.3 s: 8.13 frames/s"
+    print(project_file("image.png", "sweep.bin", "calib.txt", "sparse.npy").summary())      # a LiDAR sweep
+
+Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
+--help describes the formats), and its errors name those flags.
+
+A folder runs at the model's own rate: worker threads read and decode the next frames (OpenCV and numpy's file
+reads release the GIL) while the model runs on the current one in the calling thread, and one background thread
+post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is loaded
+once and compiled once per frame shape (jax.jit caches one executable per shape). Every output file is written
+under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an
+unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the frames after
+it.
+"""
+from __future__ import annotations
+
+import collections
+import contextlib
+import dataclasses
+import itertools
+import os
+import sys
+import time
+import warnings
+from collections.abc import Callable, Iterable, Iterator
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lipjax import inference
+from lipjax.data.folder import (check_one_depth_format, output_format, pair_frames, read_frame, read_intrinsics,
+                                write_depth)
+from lipjax.data.lidar import read_lidar_frame
+from lipjax.data.sample import Intrinsics
+from lipjax.inference import Completer, complete_frame, frame_size
+from lipjax.inputs import scene_reason
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.methods import get_completer
+from lipjax.pointcloud import IntrinsicsLike, backproject_rgbd, write_ply
+from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported, write_uncertainty
+from lipjax.viz import fitting_range
+
+DEFAULT_PNG_OUT_SCALE = 256.0
+"""PNG value per metre of .png output when no depth scale was given (KITTI's)."""
+COMPLETE_HELP = """\
+  --rgb     colour image (.png / .jpg), or a folder of them.
+  --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
+              .png  16-bit, metres = value / S with S = --depth-scale (KITTI 256, NYU 1000, TUM 5000; also the
+                    names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
+              .npy  float metres (never scaled; --depth-scale then only sets the scale of .png output).
+  --lidar   instead of --depth: a LiDAR sweep (KITTI .bin, .npy (N, >=3) x y z metres, or .pcd), projected into
+            the image with --calib (the nearest point per pixel): KITTI object calib .txt, a KITTI raw date
+            folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar; --camera picks
+            KITTI's image (2 = image_2, the default; 3 = image_3). The calibration's intrinsics serve --ply too.
+  --out     the extension chooses the format:
+              X.npy        float32 metres.
+              X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
+                           (npy input); values above 65535 are clipped, with a warning.
+              X.color.png  8-bit colour picture (turbo colour map) over --color-range; by default 0 m to the
+                           model's max depth (10 m indoor, 85 m outdoor), or to the output's 99th percentile
+                           when that is beyond the model's range or under a quarter of it (with folders, the
+                           first frame's); black = no depth.
+            With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
+            (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
+            Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
+            (rgb_00050.jpg <-> sync_depth_00050.png). The next frames are read while the model runs, outputs are
+            written in the background, and the summary line gives frames/s. A frame that fails stops the run with
+            the frames before it written whole and nothing of itself (files are renamed into place once written).
+  --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
+            metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
+  --uncertainty  also write the expected absolute error of the completed depth, metres:
+            X.npy float32 metres, or X.png a colour picture (dark blue 0 m to dark red >= --max-uncertainty, or
+            10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
+  --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
+            in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
+  --fill-all  write the dense map, depth also where no sample supports it (--max-uncertainty still applies).
+            Without it, those pixels are 0 (no depth) in --out and --ply: pixels more than one sample spacing s
+            above the highest sample of their column (sky, above the top LiDAR beam), and pixels farther than 3 s
+            from every sample (s = sqrt(area of the samples' bounding box / their number), pixels). --uncertainty
+            keeps every pixel.
+  --threads N  run on N CPU cores: every thread of the process (XLA's, OpenCV's, the frame readers') is pinned
+            to N of the cores it may use, as `taskset` does (Linux; OpenCV's threads only elsewhere). With this
+            JAX, XLA_FLAGS="--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=N" does NOT limit
+            XLA's threads; `taskset -c 0,1 lipjax ...` works as well and picks the cores.
+
+Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
+in training (200 points on 640x480 run at about half size; a 64-beam scan at full size); a new size costs one
+compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the pixel of the
+small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never averaged);
+the result is resized back (bilinear) and the measured pixels are then set to their measured values exactly.
+`--max-side N` overrides the working size: the longer side becomes at most N pixels.
+
+Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
+print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
+A frame above 2 Mpixel run without --max-side gets a one-line hint.
+"""
+"""The inputs, outputs and options of `complete_files` in the words of `lipjax complete --help`, which shows it."""
+READ_WORKERS = 2
+"""Threads that read and decode the next frames of a folder while the model runs."""
+READ_AHEAD = 4
+"""Frames read ahead of the model (they wait in memory: a KITTI frame with its depth takes about 3 MB)."""
+WRITE_BACKLOG = 4
+"""Completed frames that may wait for the writing thread before the model waits for it."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Job:
+    """One frame to complete: its input files and the files it is written to (None: not written)."""
+
+    rgb: Path
+    depth: Path  # sparse depth (.png / .npy), or a LiDAR sweep
+    out: Path
+    ply: Path | None = None
+    uncertainty: Path | None = None
+
+
+@dataclasses.dataclass(frozen=True)
+class Plan:
+    """The jobs of one `complete_files` call, the output format ("npy", "png", "color.png") and whether the
+    sparse input is metres already (.npy depth or a sweep; never scaled)."""
+
+    jobs: list[Job]
+    fmt: str
+    metres_in: bool
+
+
+def plan_jobs(rgb: str | os.PathLike, depth: str | os.PathLike, out: str | os.PathLike, *,
+              ply: str | os.PathLike | None = None, uncertainty: str | os.PathLike | None = None,
+              out_format: str | None = None) -> Plan:
+    """The frames of an RGB image and its depth, or of two folders of them (paired by `pair_frames`), with their
+    output paths: with folders, out, ply and uncertainty are folders getting <rgb stem>.<format> per frame.
+
+    Raises ValueError (a one-line message naming the `lipjax complete` flag) for missing inputs, a file given
+    with a folder, a folder mixing .png and .npy depth, or an unknown output format."""
+    rgb, depth, out = Path(rgb), Path(depth), Path(out)
+    ply, uncertainty = ply and Path(ply), uncertainty and Path(uncertainty)
+    for p in (rgb, depth):
+        if not p.exists():
+            raise ValueError(f"{p}: no such file or folder")
+    if rgb.is_dir() != depth.is_dir():
+        raise ValueError("--rgb and --depth must both be files or both be folders")
+    if not rgb.is_dir():
+        if out_format:
+            raise ValueError("--out-format is for folders; for one frame the extension of --out chooses the format")
+        fmt = output_format(out)
+        if uncertainty and uncertainty.suffix.lower() not in (".npy", ".png"):
+            raise ValueError(f"--uncertainty {uncertainty}: use .npy (metres) or .png (colour picture)")
+        return Plan([Job(rgb, depth, out, ply or None, uncertainty or None)], fmt, depth.suffix.lower() != ".png")
+    pairs = [(r, d) for _, r, d in pair_frames(rgb, depth)]
+    check_one_depth_format([d for _, d in pairs])
+    for flag, path in (("--out", out), ("--ply", ply), ("--uncertainty", uncertainty)):
+        if path and path.exists() and not path.is_dir():
+            raise ValueError(f"{flag} {path}: with input folders, {flag} must be a folder")
+    depth_suffix = pairs[0][1].suffix.lower()
+    fmt = out_format or ("png" if depth_suffix == ".png" else "npy")
+    jobs = [Job(r, d, out / f"{r.stem}.{fmt}", ply / f"{r.stem}.ply" if ply else None,
+                uncertainty / f"{r.stem}.npy" if uncertainty else None) for r, d in pairs]
+    return Plan(jobs, fmt, depth_suffix == ".npy")
+
+
+@dataclasses.dataclass(frozen=True)
+class Completed:
+    """What `complete_files` wrote.
+
+    Attributes:
+      outputs: the depth file of every frame, in order; plys: their point clouds (empty without ply).
+      out: the `out` argument (a folder for folder inputs).
+      seconds: wall-clock time of the whole call (reading, model loading and compilation, writing), seconds.
+      unsupported: share of all pixels set to 0 for want of support (0 with fill_all).
+      fitted_range_m: (0, top) metres of .color.png output fitted to the first frame; None when a range was
+        given or the format is another.
+    """
+
+    outputs: list[Path]
+    plys: list[Path]
+    out: Path
+    seconds: float
+    unsupported: float
+    fitted_range_m: tuple[float, float] | None
+
+    def summary(self) -> str:
+        """The line `lipjax complete` prints: what was written, frames/s for several frames, and notes."""
+        notes = []
+        if len(self.outputs) == 1:
+            wrote = f"{self.outputs[0]}" + (f" and {self.plys[0]}" if self.plys else "")
+        else:
+            wrote = f"{len(self.outputs)} frame(s) to {self.out} in {self.seconds:.1f} s"
+            notes.append(f"{len(self.outputs) / self.seconds:.3g} frames/s")
+        if self.unsupported:
+            notes.append(f"{100 * self.unsupported:.1f} % of the pixels without support set to 0 (--fill-all keeps "
+                         "them)")
+        if self.fitted_range_m:
+            notes.append(f"colours 0-{self.fitted_range_m[1]:.3g} m")
+        return f"wrote {wrote}" + (f": {'; '.join(notes)}" if notes else "")
+
+
+def model_max_depth(completer: Any) -> float:
+    """The depth range (metres) a completer was made for (10 m indoor, 85 m outdoor); 10 m when it has none (the
+    hand-crafted fills)."""
+    return completer.config.max_depth_m if isinstance(completer, Completer) else SCENE_MAX_DEPTH_M["indoor"]
+
+
+@dataclasses.dataclass
+class _Output:
+    """The settings of the outputs, and what the writing thread learns while it writes (first frame's range,
+    support counts). Only that thread changes it once frames are running."""
+
+    fmt: str
+    png_scale: float
+    color_range: tuple[float, float] | None
+    fill_all: bool
+    max_uncertainty: float | None
+    max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
+    fitted: bool = False
+    unsupported: int = 0
+    pixels: int = 0
+
+    def write(self, job: Job, rgb: np.ndarray, sparse: np.ndarray, dense: np.ndarray,
+              intrinsics: Intrinsics | None) -> None:
+        """Applies --max-uncertainty and the support mask to one completed frame and writes its files."""
+        if job.uncertainty or self.max_uncertainty is not None:
+            u = expected_error(sparse, dense)
+            if job.uncertainty:
+                write_uncertainty(job.uncertainty, u, self.max_uncertainty or 0.1 * self.max_depth_m)
+            if self.max_uncertainty is not None:
+                dense = drop_uncertain(dense, u, self.max_uncertainty)
+        if not self.fill_all:
+            masked = mask_unsupported(dense, sparse)
+            self.unsupported += int(((masked == 0) & (dense > 0)).sum())
+            self.pixels += dense.size
+            dense = masked
+        if self.color_range is None:
+            self.color_range, self.fitted = fitting_range(dense, self.max_depth_m), self.fmt == "color.png"
+        write_depth(job.out, dense, self.fmt, self.png_scale, self.color_range)
+        if job.ply is not None:
+            write_ply(job.ply, *backproject_rgbd(dense, rgb, intrinsics))
+
+
+def prefetched(read: Callable[[Any], Any], items: Iterable[Any], workers: int = READ_WORKERS,
+               ahead: int = READ_AHEAD) -> Iterator[Any]:
+    """read(item) for every item, in order, each computed up to `ahead` items in advance in `workers` threads.
+    An error of read(item) is raised when that item's turn comes; closing the iterator cancels what is left."""
+    items = iter(items)
+    with ThreadPoolExecutor(workers, thread_name_prefix="lipjax-read") as pool:
+        pending = collections.deque(pool.submit(read, item) for item in itertools.islice(items, ahead))
+        try:
+            while pending:
+                result = pending.popleft().result()
+                pending.extend(pool.submit(read, item) for item in itertools.islice(items, 1))
+                yield result
+        finally:
+            for future in pending:
+                future.cancel()
+
+
+class _Writer:
+    """Runs `_Output.write` on one background thread, in order; the model waits only when WRITE_BACKLOG frames
+    wait. After a failed write the frames queued behind it are not written. Leaving the block waits for every
+    queued frame, and raises the first error of a write."""
+
+    def __init__(self, output: _Output):
+        self.output, self.pending, self.failed = output, collections.deque(), False
+        self.pool = ThreadPoolExecutor(1, thread_name_prefix="lipjax-write")
+
+    def __enter__(self) -> "_Writer":
+        return self
+
+    def _write(self, *frame: Any) -> None:  # on the writing thread, one frame after the other
+        if self.failed:
+            return
+        try:
+            self.output.write(*frame)
+        except BaseException:
+            self.failed = True
+            raise
+
+    def submit(self, *frame: Any) -> None:
+        while self.pending and (len(self.pending) >= WRITE_BACKLOG or self.pending[0].done()):
+            self.pending.popleft().result()  # a failed write stops the run at once
+        self.pending.append(self.pool.submit(self._write, *frame))
+
+    def __exit__(self, *exc_info) -> None:
+        self.pool.shutdown(wait=True)
+        errors = [f.exception() for f in self.pending if not f.cancelled()]
+        if exc_info[0] is None and any(errors):
+            raise next(e for e in errors if e is not None)
+
+
+def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path, max_side: int | None,
+          log: Callable[[str], None] | None):
+    """The completer of `model` (the default of the first frame's scene when None), named with its reason to
+    `log`; warns when the frame is large enough to want --max-side."""
+    completer = get_completer(model, iterations, sparse=sparse)
+    if model is None and log is not None:
+        scene, why = scene_reason(sparse)
+        log(f"model: {completer.name}, the default for {scene} input ({why}); choose another with --model")
+    h, w = frame_size(completer, sparse, max_side)
+    if max_side is None and h * w > inference.LARGE_FRAME_PIXELS:  # read here: tests lower it
+        warnings.warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) "
+                      "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized "
+                      "(--max-side 416 with the shipped outdoor models, their training scale)", stacklevel=2)
+    return completer
+
+
+def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
+         max_side: int | None, progress: bool, log: Callable[[str], None] | None, workers: int) -> None:
+    """Reads (prefetched), completes (this thread) and writes (`_Writer`) every job of the plan, in order. The
+    model is loaded after the first frame is read (input errors come before the slow model load); the progress
+    bar starts after the line naming it."""
+    from tqdm import tqdm
+
+    completer = bar = None
+    try:
+        with contextlib.closing(prefetched(read, plan.jobs, workers)) as frames, _Writer(output) as writer:
+            for job, rgb, sparse, intrinsics in frames:
+                if completer is None:
+                    completer = _load(model, iterations, sparse, job.rgb, max_side, log)
+                    output.max_depth_m = model_max_depth(completer)
+                    bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
+                               disable=not progress or len(plan.jobs) < 2)
+                writer.submit(job, rgb, sparse, complete_frame(completer, rgb, sparse, max_side), intrinsics)
+                bar.update()
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike, *,
+                   lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
+                   depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
+                   max_side: int | None = None, out_format: str | None = None,
+                   color_range: tuple[float, float] | None = None, ply: str | os.PathLike | None = None,
+                   intrinsics: IntrinsicsLike | str | os.PathLike | None = None,
+                   uncertainty: str | os.PathLike | None = None, max_uncertainty: float | None = None,
+                   fill_all: bool = False, progress: bool = True, log: Callable[[str], None] | None = None,
+                   workers: int = READ_WORKERS) -> Completed:
+    """Completes the sparse depth of one frame or of a folder of frames and writes the results.
+
+    Args:
+      rgb, depth: an image and its sparse depth (16-bit .png, metres = value / depth_scale; .npy metres), or two
+        folders of them; or, with `lidar` and its `calib` (and KITTI `camera`) instead of `depth`, one sweep.
+      out: the output file (.npy metres, .png 16-bit at depth_scale or 256 per metre, .color.png a picture over
+        `color_range` metres, by default fitted to the first frame), or a folder with `out_format`.
+      model, iterations: anything lipjax.methods.get_completer takes; None: the default of the first frame.
+      max_side: run frames downsized to this longer side, pixels (default: the working size of the samples).
+      ply, intrinsics: also write a coloured point cloud (metres), with the RGB camera's intrinsics (pixels: an
+        Intrinsics, (fx, fy, cx, cy), K, or a file lipjax.data.folder.read_intrinsics reads; a sweep's calibration
+        gives them otherwise).
+      uncertainty, max_uncertainty: also write the expected absolute error (metres); depth 0 where it is above
+        max_uncertainty metres.
+      fill_all: keep the depth of pixels without support (lipjax.uncertainty.support_mask); by default 0 there.
+      progress: a progress bar on stderr for several frames. log: receives the line naming the default model.
+      workers: threads reading the next frames of a folder while the model runs.
+
+    Returns Completed (its `summary()` is the line the command prints). Raises ValueError / OSError with a
+    one-line message for anything the user can fix.
+    """
+    start = time.perf_counter()
+    if (depth is None) == (lidar is None):
+        raise ValueError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
+    if (lidar is None) != (calib is None):
+        raise ValueError("--lidar SWEEP and --calib FILE go together: the sweep, and its calibration with the camera")
+    if lidar is not None and Path(rgb).is_dir():
+        raise ValueError("--lidar takes one sweep with one --rgb image, not a folder")
+    if max_uncertainty is not None and not max_uncertainty >= 0:
+        raise ValueError(f"--max-uncertainty {max_uncertainty:g}: must be >= 0 metres")
+    intrinsics = read_intrinsics(intrinsics, camera)
+    if ply and intrinsics is None and lidar is None:
+        raise ValueError("--ply needs the camera intrinsics: --intrinsics fx fy cx cy or --intrinsics-file F")
+    if color_range and not color_range[1] > color_range[0]:
+        raise ValueError(f"--color-range {color_range[0]:g} {color_range[1]:g}: MAX_M must be > MIN_M")
+    plan = plan_jobs(rgb, depth if lidar is None else lidar, out, ply=ply, uncertainty=uncertainty,
+                     out_format=out_format)
+    if depth_scale and plan.metres_in and plan.fmt != "png":
+        warnings.warn(f"--depth-scale {depth_scale:g} is ignored: {'the sweep is' if lidar else '.npy depth is'} "
+                      "metres, never scaled (--depth-scale applies to .png depth, in and out)", stacklevel=2)
+
+    def read(job: Job) -> tuple[Job, np.ndarray, np.ndarray, Intrinsics | None]:
+        if lidar is None:
+            return (job, *read_frame(job.rgb, job.depth, depth_scale), intrinsics)
+        frame_rgb, sparse, calibrated = read_lidar_frame(job.rgb, job.depth, calib, camera)
+        return job, frame_rgb, sparse, intrinsics or calibrated
+
+    output = _Output(plan.fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, tuple(color_range) if color_range else None,
+                     fill_all, max_uncertainty)
+    _run(plan, read, output, model, iterations, max_side, progress, log, workers)
+    return Completed([j.out for j in plan.jobs], [j.ply for j in plan.jobs if j.ply], Path(out),
+                     time.perf_counter() - start, output.unsupported / output.pixels if output.pixels else 0.0,
+                     output.color_range if output.fitted else None)
+
+
+@dataclasses.dataclass(frozen=True)
+class Projected:
+    """What `project_file` wrote: the file, and the (H, W) float32 sparse depth in it, metres, 0 = no point."""
+
+    path: Path
+    sparse: np.ndarray
+
+    def summary(self) -> str:
+        """The line `lipjax project` prints: the file, how many pixels have depth, and their range (metres)."""
+        sparse, (h, w) = self.sparse, self.sparse.shape
+        n = int((sparse > 0).sum())
+        return (f"wrote {self.path}: depth at {n} pixels ({100 * n / sparse.size:.1f} % of {w}x{h}), "
+                f"{sparse[sparse > 0].min():.2f} to {sparse.max():.2f} m")
+
+
+def project_file(rgb: str | os.PathLike, lidar: str | os.PathLike, calib: str | os.PathLike,
+                 out: str | os.PathLike, *, camera: int = 2, depth_scale: float | None = None) -> Projected:
+    """Projects a LiDAR sweep into the camera of `rgb` (lipjax.data.lidar.read_lidar_frame) and writes the sparse
+    depth to `out` (.npy metres, .png 16-bit at depth_scale or 256 per metre, .color.png a picture from 0 to its
+    farthest point)."""
+    fmt = output_format(out)
+    _, sparse, _ = read_lidar_frame(rgb, lidar, calib, camera)
+    write_depth(out, sparse, fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
+    return Projected(Path(out), sparse)

@@ -1,0 +1,259 @@
+"""Completing folders at the model's own rate (lipjax.files.complete_files behind `lipjax complete`): the frames are
+read ahead in threads and written in the background, yet the outputs are those of running the frames one by one,
+in order; a failing frame stops the run with one line and nothing half-written; `--threads N` pins the process."""
+import os
+import pathlib
+import re
+import subprocess
+import sys
+import threading
+
+import cv2
+import numpy as np
+import pytest
+
+import lipjax
+from lipjax import cli, files, model_io
+from lipjax.inference import compiled_apply
+from lipjax.methods import get_completer
+from lipjax.model import LIPConfig
+from lipjax.priors.network import network_preset
+from lipjax.utils import written_whole
+
+H, W = 24, 32
+SCALE = 256.0
+CONFIG = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
+CACHE = pathlib.Path(__file__).resolve().parents[1] / ".jax_cache"
+INTRINSICS = ["--intrinsics", "30", "30", "15.5", "11.5"]
+
+
+@pytest.fixture(autouse=True)
+def _same_compilation_cache(monkeypatch):
+    monkeypatch.setenv("LIPJAX_CACHE_DIR", str(CACHE))  # main() enables the cache: the one the session uses
+
+
+@pytest.fixture(scope="module")
+def model(tmp_path_factory):
+    """The path stem of a saved tiny model with random weights (the network changes the depth)."""
+    stem = tmp_path_factory.mktemp("model") / "tiny"
+    model_io.save(stem, CONFIG, lipjax.Completer.random(CONFIG, seed=1).params)
+    return str(stem)
+
+
+def _frames(root, stems, corrupt=()):
+    """rgb/<stem>.png and depth/<stem>.png (16-bit at SCALE) frames, sample (0, 0) at 1 + index metres, so a frame
+    is known by its input; the RGB of the stems in `corrupt` is not a PNG."""
+    for sub in ("rgb", "depth"):
+        (root / sub).mkdir(parents=True)
+    for i, stem in enumerate(stems):
+        rng = np.random.default_rng(i)
+        rgb = rng.integers(0, 256, (H, W, 3), dtype=np.uint8)
+        sparse = np.where(rng.random((H, W)) < 0.1, np.round(rng.uniform(1, 5, (H, W)) * SCALE) / SCALE, 0)
+        sparse[0, 0] = 1 + i
+        cv2.imwrite(str(root / "depth" / f"{stem}.png"), np.round(sparse * SCALE).astype(np.uint16))
+        if stem in corrupt:
+            (root / "rgb" / f"{stem}.png").write_bytes(b"not a png")
+        else:
+            cv2.imwrite(str(root / "rgb" / f"{stem}.png"), rgb[..., ::-1])
+    return root
+
+
+def _complete(model, rgb, depth, out, *extra):
+    return cli.main(["complete", "--rgb", str(rgb), "--depth", str(depth), "--depth-scale", "256", "--model", model,
+                     "--out", str(out), *map(str, extra)])
+
+
+@pytest.mark.parametrize("fmt, extra", [("png", ["--uncertainty", "U"]),
+                                        ("color.png", ["--color-range", "0", "6", "--max-uncertainty", "0.5"])])
+def test_a_folder_writes_what_the_frames_one_by_one_write(model, tmp_path, fmt, extra, capsys):
+    """Every file of a folder run (depth, PLY, uncertainty) is byte for byte the one-frame command's, the model
+    compiles once for the frames' one shape, and the summary line gives the number of frames, the time and
+    frames/s."""
+    stems = ["0", "1", "2", "10"]
+    data = _frames(tmp_path / "in", stems)
+    folder_extra = [a if a != "U" else tmp_path / "unc" for a in extra]
+    assert lipjax.load_model(model).config == CONFIG  # so the model file runs the jitted function of CONFIG
+    compiled = compiled_apply(CONFIG, False)._cache_size()
+    assert _complete(model, data / "rgb", data / "depth", tmp_path / "out", "--out-format", fmt,
+                     "--ply", tmp_path / "ply", *INTRINSICS, *folder_extra) == 0
+    assert compiled_apply(CONFIG, False)._cache_size() <= compiled + 1  # four frames of one shape: one compilation
+    summary = capsys.readouterr().err.strip().splitlines()[-1]
+    assert re.fullmatch(rf"wrote 4 frame\(s\) to {re.escape(str(tmp_path / 'out'))} in \d+\.\d s: [\d.]+ "
+                        r"frames/s(; .*)?", summary), summary
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(f"{s}.{fmt}" for s in stems)
+    for stem in stems:
+        one = tmp_path / "one" / stem
+        one_extra = [a if a != "U" else one / "u.npy" for a in extra]
+        assert _complete(model, data / "rgb" / f"{stem}.png", data / "depth" / f"{stem}.png", one / f"d.{fmt}",
+                         "--ply", one / "c.ply", *INTRINSICS, *one_extra, "-q") == 0
+        assert (tmp_path / "out" / f"{stem}.{fmt}").read_bytes() == (one / f"d.{fmt}").read_bytes(), stem
+        assert (tmp_path / "ply" / f"{stem}.ply").read_bytes() == (one / "c.ply").read_bytes(), stem
+        if "U" in extra:
+            assert (tmp_path / "unc" / f"{stem}.npy").read_bytes() == (one / "u.npy").read_bytes(), stem
+
+
+class _Recording:
+    """A completer that notes which frame it completes (its sample at (0, 0), metres), then fills by nearest."""
+
+    name = "recording"
+
+    def __init__(self):
+        self.fill, self.seen = get_completer("nearest"), []
+
+    def __call__(self, rgb, sparse):
+        self.seen.append(float(sparse[0, 0]))
+        return self.fill(rgb, sparse)
+
+
+def test_frames_run_once_each_in_natural_order_while_the_next_are_read_ahead(tmp_path):
+    stems = ["a1", "a2", "a3", "a10", "a11", "a20"]
+    data = _frames(tmp_path / "in", stems)
+    recording = _Recording()
+    done = files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model=recording,
+                                fill_all=True, progress=False)
+    assert recording.seen == [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]  # files in the order of pair_frames: a1 a2 a3 a10 ...
+    assert done.outputs == [tmp_path / "out" / f"{s}.png" for s in stems] and done.unsupported == 0
+    for i, stem in enumerate(stems):
+        raw = cv2.imread(str(tmp_path / "out" / f"{stem}.png"), cv2.IMREAD_UNCHANGED)
+        assert raw[0, 0] == (1 + i) * SCALE
+
+
+def test_reading_and_writing_overlap_the_model(tmp_path, monkeypatch):
+    """The next frame is read while the model runs, and a frame is written while the model runs on the next one:
+    the model waits on frame 0 until frame 1's read has begun, and frame 0's write waits until the model runs on
+    frame 1. A loop that reads, completes and writes in turn would wait forever (each wait fails after 10 s)."""
+    data = _frames(tmp_path / "in", ["0", "1", "2"])
+    reading_1, model_on_1 = threading.Event(), threading.Event()
+    real_read, real_write = files.read_frame, files.write_depth
+
+    def read(rgb, depth, scale):
+        if pathlib.Path(rgb).stem == "1":
+            reading_1.set()
+        return real_read(rgb, depth, scale)
+
+    def write(path, *args):
+        if pathlib.Path(path).stem == "0":
+            assert model_on_1.wait(10), "frame 0 was written before the model ran on frame 1"
+        real_write(path, *args)
+
+    class Waiting(_Recording):
+        def __call__(self, rgb, sparse):
+            if sparse[0, 0] == 1:
+                assert reading_1.wait(10), "frame 1 was not read while the model ran on frame 0"
+            if sparse[0, 0] == 2:
+                model_on_1.set()
+            return super().__call__(rgb, sparse)
+
+    monkeypatch.setattr(files, "read_frame", read)
+    monkeypatch.setattr(files, "write_depth", write)
+    model = Waiting()
+    files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model=model,
+                         progress=False)
+    assert model.seen == [1.0, 2.0, 3.0] and len(list((tmp_path / "out").iterdir())) == 3
+
+
+def test_prefetched_keeps_the_order_and_raises_an_error_in_its_turn():
+    def read(i):
+        if i == 3:
+            raise ValueError("frame 3 is broken")
+        return i * i
+
+    got = []
+    with pytest.raises(ValueError, match="frame 3 is broken"):
+        for value in files.prefetched(read, range(8), workers=3, ahead=4):
+            got.append(value)
+    assert got == [0, 1, 4]
+
+
+def test_a_corrupt_frame_stops_the_folder_with_one_line_and_nothing_half_written(model, tmp_path, capsys):
+    """The frames before the corrupt one are written whole (the one-frame command's bytes); the corrupt one and
+    those after it are not written at all, and no temporary file is left."""
+    stems = ["0", "1", "2", "3", "4"]
+    data = _frames(tmp_path / "in", stems, corrupt={"2"})
+    rc = _complete(model, data / "rgb", data / "depth", tmp_path / "out", "--ply", tmp_path / "ply", *INTRINSICS)
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.strip() and "frame/s" not in line and "%|" not in line]
+    assert rc == 1 and lines == [f"lipjax: error: Cannot read RGB image (missing, corrupt or unsupported format): "
+                                 f"{data / 'rgb' / '2.png'}"], err
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0.png", "1.png"]
+    assert sorted(p.name for p in (tmp_path / "ply").iterdir()) == ["0.ply", "1.ply"]
+    for stem in ("0", "1"):
+        assert _complete(model, data / "rgb" / f"{stem}.png", data / "depth" / f"{stem}.png", tmp_path / "d.png",
+                         "-q") == 0
+        assert (tmp_path / "out" / f"{stem}.png").read_bytes() == (tmp_path / "d.png").read_bytes()
+
+
+def test_a_failing_write_stops_the_run_and_leaves_no_partial_file(tmp_path, monkeypatch):
+    """A write that fails half way (a full disk) leaves neither the file nor its temporary, and the frames queued
+    behind it are not written; the frames before it stay."""
+    data = _frames(tmp_path / "in", ["0", "1", "2", "3"])
+    real, calls = cv2.imwrite, []
+
+    def disk_full_on_the_third(path, image, *args):
+        calls.append(path)
+        if len(calls) == 3:
+            pathlib.Path(path).write_bytes(b"half a fi")
+            raise OSError(28, "No space left on device")
+        return real(path, image, *args)
+
+    monkeypatch.setattr(cv2, "imwrite", disk_full_on_the_third)
+    with pytest.raises(OSError, match="No space left"):
+        files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model="nearest",
+                             progress=False)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0.png", "1.png"] and len(calls) == 3
+
+
+def test_written_whole_keeps_the_old_file_when_a_write_fails(tmp_path):
+    target = tmp_path / "sub" / "d.npy"
+    with written_whole(target) as path:
+        assert path.parent == target.parent and path.name.endswith(".npy") and path != target
+        np.save(path, np.ones(3, np.float32))
+    with pytest.raises(RuntimeError):
+        with written_whole(target) as path:
+            path.write_bytes(b"garbage")
+            raise RuntimeError("interrupted")
+    np.testing.assert_array_equal(np.load(target), np.ones(3, np.float32))
+    assert [p.name for p in target.parent.iterdir()] == ["d.npy"]
+
+
+def test_threads_flag_limits_the_process_before_the_run(model, tmp_path, monkeypatch, capsys):
+    """`--threads N` calls lipjax.utils.limit_cpu_threads(N) (stubbed here: pinning would pin the test session)
+    and reads with at most N threads; the outputs do not change."""
+    data = _frames(tmp_path / "in", ["0", "1"])
+    called, workers = [], []
+    monkeypatch.setattr(cli, "limit_cpu_threads", called.append)
+    real = files.prefetched
+    monkeypatch.setattr(files, "prefetched", lambda read, items, n: workers.append(n) or real(read, items, n))
+    assert _complete("nearest", data / "rgb", data / "depth", tmp_path / "a", "--threads", "1", "-q") == 0
+    assert called == [1] and workers == [1]
+    assert _complete("nearest", data / "rgb", data / "depth", tmp_path / "b", "-q") == 0
+    assert called == [1] and workers == [1, files.READ_WORKERS]
+    for stem in ("0", "1"):
+        assert (tmp_path / "a" / f"{stem}.png").read_bytes() == (tmp_path / "b" / f"{stem}.png").read_bytes()
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="CPU affinity is Linux's")
+def test_limit_cpu_threads_pins_every_thread_and_sizes_xla_and_opencv():
+    """In a fresh process (pinning is for the whole process): after limit_cpu_threads(1) every thread, XLA's
+    included, may run on one core only, OpenCV uses one thread and XLA's Eigen pool has at most one."""
+    code = ("import os, cv2, jax.numpy as jnp; from lipjax.utils import limit_cpu_threads; "
+            "cores = limit_cpu_threads(1); jnp.ones((64, 64)).sum().block_until_ready(); "
+            "tasks = os.listdir('/proc/self/task'); "
+            "names = [open(f'/proc/self/task/{t}/comm').read().strip() for t in tasks]; "
+            "print(len(cores), cv2.getNumThreads(), sorted({len(os.sched_getaffinity(int(t))) for t in tasks}), "
+            "names.count('tf_XLAEigen'))")
+    env = {**os.environ, "PYTHONPATH": str(pathlib.Path(__file__).resolve().parents[1])}
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=env)
+    assert result.returncode == 0, result.stderr
+    cores, cv_threads, affinities, eigen = result.stdout.split(" ", 3)
+    assert (cores, cv_threads, affinities, int(eigen) <= 1) == ("1", "1", "[1]", True), result.stdout
+
+
+def test_the_summary_line_names_the_rate_the_masked_share_and_the_fitted_colours():
+    two = files.Completed([pathlib.Path("o/a.png"), pathlib.Path("o/b.png")], [], pathlib.Path("o"), 0.8, 0.25,
+                          (0.0, 42.0))
+    assert two.summary() == ("wrote 2 frame(s) to o in 0.8 s: 2.5 frames/s; 25.0 % of the pixels without support set "
+                             "to 0 (--fill-all keeps them); colours 0-42 m")
+    one = files.Completed([pathlib.Path("d.npy")], [pathlib.Path("c.ply")], pathlib.Path("d.npy"), 3.0, 0.0, None)
+    assert one.summary() == "wrote d.npy and c.ply"
