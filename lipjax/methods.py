@@ -33,7 +33,9 @@ from lipjax.classical import (
 from lipjax.classical.completer import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
 from lipjax.inference import Completer, complete_frame, default_model, load_model
+from lipjax import model_io
 from lipjax.inputs import suggest_scene
+from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
 from lipjax.uncertainty import drop_uncertain, expected_error
 
@@ -80,8 +82,9 @@ def get_completer(model: Any = None, iterations: int | None = None, sparse: np.n
 
 
 def available_methods(scene: str) -> list[str]:
-    """Names of the methods that can run for a scene now: shipped learned models first, then the hand-crafted."""
-    learned = [m for m in available() if m.endswith(f"-{scene}")]
+    """Names of the methods that can run for a scene now: shipped learned models first (those of the scene and those
+    trained on both scenes), then the hand-crafted."""
+    learned = [m for m in available() if m.endswith(f"-{scene}") or model_io.metadata(m).get("data") == MIXED_SCENES]
     return learned + list(CLASSICAL)
 
 

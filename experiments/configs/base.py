@@ -93,10 +93,11 @@ OUTDOOR = TrainConfig(
     batch_size=8, g_steps=900, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
     inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
 )
-# Rooms and streets: the shared-encoder prox (it never sees a metric depth) from the linear fill, each frame's error
-# in units of its own sample scale. No schedule: its config (fast.py, lip_any) sets it.
+# Rooms and streets: the shared-encoder prox (it never sees a metric depth) from the "auto" fill (nearest on scan
+# lines, linear elsewhere: benchmarks/initial_fill.py), each frame's error in units of its own sample scale. No
+# schedule: its config (fast.py, lip_any) sets it.
 MIXED = TrainConfig(
-    name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE), data=MIXED_DATA,
+    name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, "auto"), data=MIXED_DATA,
     batch_size=8, loss="l1", loss_scale="samples",
 )
 SCENES: dict[str, TrainConfig] = {"indoor": INDOOR, "outdoor": OUTDOOR, "mixed": MIXED}
