@@ -11,17 +11,19 @@ training saw, and only there:
                      sqrt(MAX_WORKING_PIXELS / (H W)))        and at most MAX_WORKING_PIXELS pixels
     (h, w)     = round(s H), round(s W), the shorter side at least MIN_WORKING_SIDE_PX
 
-Sparse inputs (200 points on 480x640: 39 px apart) run at about half size. Dense ones (a 64-beam scan, ~5 px apart
-on a KITTI frame) already lie closer than TARGET_SPACING_PX, but a KITTI-size frame still runs below full size: the
-prox's receptive field and its training frames (up to 256x320) cover a fixed number of pixels, and a scan at its
-full 352x1216 leaves the prox's field of view a narrow slice of the street (measured: the pixel cap lowers the
-error on synthetic 352x1216 streets, and it makes the frame ~4x cheaper). The data-consistency step and
+Sparse inputs (200 points on 480x640: 39 px apart) run at 0.56x (270x360, capped to 60,000 pixels: 212x283). Dense
+ones (a 64-beam scan, ~5 px apart on a KITTI frame) already lie closer than TARGET_SPACING_PX, but a KITTI-size
+frame still runs below full size (0.38x, 132x455): the prox's receptive field and its training frames (128x160
+crops) cover a fixed number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow
+slice of the street. Measured with lip-any on synthetic test frames (geometric-mean RMSE ratio to linear, native
+size -> rule): 64-beam 352x1216 streets 0.670 -> 0.449, 200 points on 480x640 rooms 0.962 -> 0.846, 50 points
+1.441 -> 0.896; the frame is also 7x cheaper at KITTI size. The data-consistency step and
 the output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every
 measured pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
 
-TARGET_SPACING_PX was chosen on synthetic renders larger than the training frames, by a rule fixed before any real
-frame was scored (benchmarks/working_resolution.py: the working spacing with the lowest geometric-mean RMSE ratio to
-the linear fill over rooms at 480x640 and streets at 352x1216).
+TARGET_SPACING_PX and MAX_WORKING_PIXELS were chosen on synthetic renders larger than the training frames, by a rule
+fixed before any real frame was scored (benchmarks/working_resolution.py --model lip-any: the (T, P) with the lowest
+geometric-mean RMSE ratio to the linear fill over rooms at 480x640 and streets at 352x1216; T=22 px, P=60,000: 0.732).
 """
 from __future__ import annotations
 
@@ -29,8 +31,8 @@ import math
 
 import numpy as np
 
-TARGET_SPACING_PX = 16.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
-MAX_WORKING_PIXELS = 100_000  # the largest working size, pixels (see the module doc)
+TARGET_SPACING_PX = 22.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
+MAX_WORKING_PIXELS = 60_000  # the largest working size, pixels (see the module doc)
 MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
 MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
 MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cost more than it brings

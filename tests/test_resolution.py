@@ -33,21 +33,21 @@ def test_sample_spacing_is_sqrt_of_pixels_per_sample():
 
 
 def test_working_size_puts_the_samples_at_the_target_spacing():
-    spacing = math.sqrt(480 * 640 / 200)  # 39.2 px
-    h, w = working_size((480, 640), spacing)
+    spacing = math.sqrt(240 * 320 / 50)  # 39.2 px
+    h, w = working_size((240, 320), spacing)
     s = TARGET_SPACING_PX / spacing
-    assert (h, w) == (round(480 * s), round(640 * s))
+    assert h * w < MAX_WORKING_PIXELS and (h, w) == (round(240 * s), round(320 * s))
     # at the working size the n samples lie TARGET_SPACING_PX apart (up to rounding)
-    assert math.sqrt(h * w / 200) == pytest.approx(TARGET_SPACING_PX, rel=0.01)
+    assert math.sqrt(h * w / 50) == pytest.approx(TARGET_SPACING_PX, rel=0.01)
 
 
 def test_dense_samples_and_small_frames_run_at_full_size():
-    assert working_size((240, 400), 4.7) == (240, 400)  # a dense scan on a frame under the pixel cap
+    assert working_size((200, 280), 4.7) == (200, 280)  # a dense scan on a frame under the pixel cap
     # a KITTI-size scan: the pixel cap alone sets the scale
     h, w = working_size((352, 1216), 4.7)
     assert h * w == pytest.approx(MAX_WORKING_PIXELS, rel=0.01) and w / h == pytest.approx(1216 / 352, rel=0.01)
     s = MIN_SCALE_CHANGE + 0.01
-    assert working_size((300, 400), TARGET_SPACING_PX / s) == (300, 400)  # a resize would not pay
+    assert working_size((200, 280), TARGET_SPACING_PX / s) == (200, 280)  # a resize would not pay
     # never below MIN_WORKING_SIDE_PX on the shorter side, however sparse
     assert min(working_size((480, 640), 1000.0)) == MIN_WORKING_SIDE_PX
     with pytest.raises(ValueError, match="spacing_px"):
