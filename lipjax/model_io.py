@@ -132,9 +132,9 @@ TABLE_COLUMNS = ("MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL RMSE",
 def table(defaults: dict[str, str]) -> str:
     """The shipped models as a text table in aligned columns (TABLE_COLUMNS), one row per model, from each model's
     config and metadata: DEFAULT names the scene(s) whose default it is (`defaults`: scene -> model name, e.g.
-    lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox> prox" or the end-to-end network's
+    lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
     type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
-    (sampler, data); "-" where unknown or not applicable."""
+    (its sampler); "-" where unknown or not applicable."""
     rows = [TABLE_COLUMNS]
     for name in available():
         config = config_from_dict(_read_doc(resolve(name))["config"])
@@ -142,12 +142,12 @@ def table(defaults: dict[str, str]) -> str:
         rmse = meta.get("val_metrics", {}).get("rmse_m")
         if isinstance(config, LIPConfig):
             prior = {cls: p for p, cls in _prior_types().items()}[type(config.prior)]
-            kind, iters, z0 = f"LIP, {prior} prox", str(config.num_iterations), config.initial_estimate
+            kind, iters, z0 = f"LIP, {prior}", str(config.num_iterations), config.initial_estimate
         else:
             kind, iters, z0 = model_type_name(config), "-", "-"
         rows.append((name, ", ".join(s for s, m in defaults.items() if m == name), kind, iters, z0,
                      f"{config.max_depth_m:g} m", "-" if rmse is None else f"{rmse:.4f} m",
-                     f"{meta['val_sampler']}, {meta.get('data', '?')}" if "val_sampler" in meta else "-",
+                     meta.get("val_sampler", "-"),
                      f"{meta['images_seen']:,} images" if "images_seen" in meta else "-"))
     widths = [max(len(r[i]) for r in rows) for i in range(len(TABLE_COLUMNS))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)

@@ -111,14 +111,14 @@ def test_lidar_pattern_and_scene():
 
 
 def test_default_model_follows_the_input():
-    assert methods.get_completer(sparse=_lidar(20.0)).name == "lip-ad-outdoor"
+    assert methods.get_completer(sparse=_lidar(20.0)).name == "lip-ad-fast-outdoor"
     assert methods.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-fast-indoor"
     assert methods.get_completer().name == "lip-fast-indoor"
 
 
 def test_the_completer_checks_against_its_range():
     rgb = np.zeros((96, 200, 3), np.uint8)
-    with pytest.warns(UserWarning, match="looks like outdoor data, use lip-ad-outdoor"):
+    with pytest.warns(UserWarning, match="looks like outdoor data, use lip-ad-fast-outdoor"):
         lipjax.Completer.random()(rgb, _lidar(20.0))
     with pytest.raises(InputError, match="over 10x the 10 m range of random"):
         lipjax.Completer.random()(rgb, _lidar(300.0))
