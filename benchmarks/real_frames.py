@@ -14,8 +14,8 @@ pixels. The reference is `linear` (Delaunay piecewise-linear, nearest outside th
 Columns: the default path (`lipjax complete` without flags: `get_completer(None, sparse)` picks the model and
 `complete_frame` its working size), the same with a uniform grey image (the RGB guidance's worth: grey / RGB),
 ip_basic and colorization. `--model` scores one model through the same path instead of the default choice.
-`--sweep` also runs the model at several target sample spacings (lipjax.resolution) and plots the geometric-mean
-ratio against the working resolution.
+`--sweep` also runs the model at several target sample spacings (lipjax.resolution, with its pixel cap) and at the
+native size ("full"), and plots the geometric-mean ratio against the working resolution.
 """
 from __future__ import annotations
 
@@ -72,7 +72,8 @@ def rmse(pred: np.ndarray, sample: Sample, sparse: np.ndarray) -> float:
 
 def summary(ratios: list[float]) -> str:
     r = np.asarray(ratios)
-    return f"wins {int((r < 1).sum())}/{len(r)}, median {np.median(r):.3f}, geometric mean {np.exp(np.log(r).mean()):.3f}"
+    gm = np.exp(np.log(r).mean())
+    return f"wins {int((r < 1).sum())}/{len(r)}, median {np.median(r):.3f}, geometric mean {gm:.3f}"
 
 
 def main(argv=None) -> None:
@@ -102,9 +103,9 @@ def main(argv=None) -> None:
             row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
         if args.sweep:
             spacing = sample_spacing_px(sparse)
-            row["sweep"] = {str(t): rmse(complete_at(completer, sample.rgb, sparse,
-                                                     working_size(sample.shape, spacing, t)), sample, sparse) / ref
-                            for t in SWEEP_TARGETS_PX}
+            row["sweep"] = {
+                str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(sample.shape, spacing, t)), sample,
+                             sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
         print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "
@@ -131,6 +132,11 @@ def main(argv=None) -> None:
         print(f"\nwrote {args.json}")
 
 
+def _sweep_size(shape: tuple[int, int], spacing: float, target: float) -> tuple[int, int]:
+    """The working size with target spacing `target` (and the pixel cap); `target` >= 1e9: the native size."""
+    return tuple(shape) if target >= 1e9 else working_size(shape, spacing, target)
+
+
 def sweep_table(rows: list[dict], plot: str | None) -> None:
     """Geometric-mean ratio per group against the target spacing (the working resolution)."""
     groups = sorted({r["group"] for r in rows})
@@ -154,6 +160,7 @@ def sweep_table(rows: list[dict], plot: str | None) -> None:
             ax.plot(xs, vals, marker="o", label=g)
         ax.axhline(1.0, color="grey", lw=0.8, ls="--")
         ax.set_xscale("log")
+        ax.minorticks_off()
         ax.set_xticks(xs, [f"{t:g}" if t < 1e9 else "full" for t in SWEEP_TARGETS_PX])
         ax.set_xlabel("target sample spacing at the working size (px); 'full' = native size")
         ax.set_ylabel("RMSE / linear (geometric mean)")
