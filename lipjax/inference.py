@@ -1,7 +1,7 @@
 """The jit-compiled inference entry point: `Completer` (a model with its parameters); inputs checked by lipjax.inputs.
 
 Also `load_model` (a saved model by name or path), `default_model` (the shipped default of a scene), and
-`complete_frame`, which can run a large frame at a reduced size (`max_side`). Names of every kind of completer
+`complete_frame`, which runs a learned model at its working size (lipjax.resolution) and returns full-size depth. Names of every kind of completer
 (learned, classical, a path) resolve in lipjax.methods.get_completer.
 
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
@@ -178,6 +178,11 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     """
     import cv2
 
+    rgb, sparse, batched = check_inputs(rgb, sparse_m)  # before any resize could hide a size mismatch
+    if batched:
+        raise InputError(f"one frame at a time: rgb (H, W, 3) and sparse (H, W), got rgb {np.shape(rgb)}; loop over "
+                         "a batch, or call the completer itself at one size")
+    rgb, sparse_m = rgb[0], sparse[0]
     big_h, big_w = sparse_m.shape
     h, w = size
     if (h, w) == (big_h, big_w):

@@ -42,6 +42,22 @@ def register_model_type(name: str):
     return register
 
 
+# Prior (prox) config types by the name written in model files ("prior_type"), filled by `register_prior_type`.
+PRIOR_TYPES: dict[str, type] = {}
+
+
+def register_prior_type(name: str):
+    """Class decorator: records a prior config class (lipjax.priors) under `name`, the prior type in model files."""
+
+    def register(cls: type) -> type:
+        if name in PRIOR_TYPES and PRIOR_TYPES[name] is not cls:
+            raise ValueError(f"prior type {name!r} is already registered to {PRIOR_TYPES[name].__name__}")
+        PRIOR_TYPES[name] = cls
+        return cls
+
+    return register
+
+
 def parameter_count(params: Params) -> int:
     """Number of scalars in a parameter pytree (all iterations together)."""
     return int(sum(np.prod(leaf.shape) for leaf in jax.tree_util.tree_leaves(params)))

@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from lipjax import model_io
 from lipjax.classical import (
     ColorizationFill,
     IPBasicAdaptiveFill,
@@ -33,7 +34,6 @@ from lipjax.classical import (
 from lipjax.classical.completer import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
 from lipjax.inference import Completer, complete_frame, default_model, load_model
-from lipjax import model_io
 from lipjax.inputs import suggest_scene
 from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
@@ -98,7 +98,7 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_unce
     (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
     """
     completer = get_completer(model, sparse=sparse)
-    rgb, sparse = np.asarray(rgb), np.asarray(sparse, np.float32)
+    rgb, sparse = np.asarray(rgb), np.asarray(sparse)
     if sparse.ndim == 3:
         dense = np.stack([complete_frame(completer, c, y) for c, y in zip(rgb, sparse)])
     else:

@@ -20,9 +20,11 @@ import flax.serialization
 import jax
 import numpy as np
 
-from lipjax.interfaces import MODEL_TYPES, model_type_name
+from lipjax.interfaces import MODEL_TYPES, PRIOR_TYPES, model_type_name
 from lipjax.model import LIPConfig
-from lipjax.priors.network import NetworkPrior
+import lipjax.priors.guided  # noqa: F401  (registers the prior types model files name)
+import lipjax.priors.network  # noqa: F401
+import lipjax.priors.wavelet  # noqa: F401
 from lipjax.shipped import DEFAULT_MODELS, WEIGHTS_DIR, available
 
 
@@ -33,13 +35,6 @@ class ModelFileError(ValueError):
 def _with_suffix(stem: pathlib.Path, suffix: str) -> pathlib.Path:
     """stem + suffix, keeping any dots of the stem (Path.with_suffix would turn "smoke.v2" into "smoke.json")."""
     return stem.with_name(stem.name + suffix)
-
-
-def _prior_types() -> dict[str, type]:
-    from lipjax.priors.guided import GuidedPrior
-    from lipjax.priors.wavelet import WaveletPrior
-
-    return {"network": NetworkPrior, "guided": GuidedPrior, "wavelet": WaveletPrior}
 
 
 def _model_types() -> dict[str, type]:
@@ -60,7 +55,7 @@ def config_to_dict(config) -> dict:
     model_type = model_type_name(config)
     if not isinstance(config, LIPConfig):
         return {"model_type": model_type, **dataclasses.asdict(config)}
-    prior_type = {cls: name for name, cls in _prior_types().items()}[type(config.prior)]
+    prior_type = {cls: name for name, cls in PRIOR_TYPES.items()}[type(config.prior)]
     fields = {f.name: getattr(config, f.name) for f in dataclasses.fields(config) if f.name != "prior"}
     return {"model_type": "lip", "prior_type": prior_type, "prior": dataclasses.asdict(config.prior), **fields}
 
@@ -73,11 +68,10 @@ def config_from_dict(d: dict):
         raise ValueError(f"unknown model type {model_type!r} in model file; known: {sorted(types)}")
     if model_type != "lip":
         return types[model_type](**_tuples(d))
-    priors = _prior_types()
     kind = d.pop("prior_type")
-    if kind not in priors:
-        raise ValueError(f"unknown prior type {kind!r} in model file; known: {sorted(priors)}")
-    return LIPConfig(prior=priors[kind](**_tuples(d.pop("prior"))), **d)
+    if kind not in PRIOR_TYPES:
+        raise ValueError(f"unknown prior type {kind!r} in model file; known: {sorted(PRIOR_TYPES)}")
+    return LIPConfig(prior=PRIOR_TYPES[kind](**_tuples(d.pop("prior"))), **d)
 
 
 def _atomic_write(path: pathlib.Path, data: bytes) -> None:
@@ -141,7 +135,7 @@ def table(defaults: dict[str, str]) -> str:
         meta = metadata(name)
         rmse = meta.get("val_metrics", {}).get("rmse_m")
         if isinstance(config, LIPConfig):
-            prior = {cls: p for p, cls in _prior_types().items()}[type(config.prior)]
+            prior = {cls: p for p, cls in PRIOR_TYPES.items()}[type(config.prior)]
             kind, iters, z0 = f"LIP, {prior}", str(config.num_iterations), config.initial_estimate
         else:
             kind, iters, z0 = model_type_name(config), "-", "-"

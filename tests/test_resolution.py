@@ -90,3 +90,13 @@ def test_frame_size_follows_the_samples_for_learned_models_only():
     assert inference.frame_size(model, sparse, max_side=160) == (120, 160)
     with pytest.raises(inference.InputError, match="max_side 3"):
         inference.frame_size(model, sparse, max_side=3)
+
+
+def test_complete_at_checks_its_inputs_before_resizing():
+    # a resize would make a wrong-size image fit: the mismatch is an error first
+    sparse = _sparse(48, 64, 60, seed=3)
+    with pytest.raises(inference.InputError, match="shape mismatch"):
+        inference.complete_at(_LinearAtAnySize(), np.zeros((20, 30, 3), np.uint8), sparse, (24, 32))
+    with pytest.raises(inference.InputError, match="float metres"):
+        inference.complete_at(_LinearAtAnySize(), np.zeros((48, 64, 3), np.uint8), (sparse * 1000).astype(np.uint16),
+                              (24, 32))

@@ -31,7 +31,7 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
-from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_prior_type
 from lipjax.priors.base import EncodedGuidance, SharedEncoderPrior
 
 DOWNSAMPLING = 8  # space-to-depth, then two stride-2 stages
@@ -212,6 +212,7 @@ def sample_scale(y: jax.Array, weights: jax.Array) -> jax.Array:
     return jnp.where(count > 0, jnp.exp(log_mean), 1.0)
 
 
+@register_prior_type("guided")
 @dataclasses.dataclass(frozen=True)
 class GuidedPrior(SharedEncoderPrior):
     """The shared-encoder prox as a `SharedEncoderPrior`: `encode` once per frame, then `apply` per iteration.

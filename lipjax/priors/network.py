@@ -38,7 +38,7 @@ import flax.linen as nn
 import jax
 import jax.numpy as jnp
 
-from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_prior_type
 
 DOWNSAMPLING = 8  # three stride-2 bottleneck blocks
 LOG_DOMAIN_FLOOR = 1e-3  # depth_domain="log": v is floored at this fraction of max_depth before the log
@@ -122,6 +122,7 @@ class ProxNet(nn.Module):
         return z[:, :height, :width] * self.max_depth_m
 
 
+@register_prior_type("network")
 @dataclasses.dataclass(frozen=True)
 class NetworkPrior:
     """The learned prox as a prior (lipjax.priors.base): hashable config + init/apply on a parameter pytree."""

@@ -36,7 +36,7 @@ import math
 import jax
 import jax.numpy as jnp
 
-from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_prior_type
 
 _SQRT2 = math.sqrt(2.0)
 _SQRT3 = math.sqrt(3.0)
@@ -164,6 +164,7 @@ def cycle_offsets(shifts: int, levels: int) -> list[int]:
     return sorted({(i * 2**levels) // shifts for i in range(shifts)})
 
 
+@register_prior_type("wavelet")
 @dataclasses.dataclass(frozen=True)
 class WaveletPrior:
     """Wavelet soft-thresholding prox (the prior interface of lipjax.priors.base).
