@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from lipjax.classical.completer import DepthCompleter
+from lipjax.interfaces import DepthCompleter
 from lipjax.data.protocols import Protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol

@@ -90,9 +90,11 @@ def save_exported(exported: jax.export.Exported, path: str | os.PathLike) -> pat
 
 @dataclasses.dataclass(frozen=True)
 class ExportedCompleter:
-    """A deserialised exported model: `(rgb uint8 (B,H,W,3), sparse float32 (B,H,W) metres) -> depth (B,H,W)`."""
+    """A deserialised exported model, a `lipjax.interfaces.DepthCompleter` of fixed shape:
+    `(rgb uint8 (B,H,W,3), sparse float32 (B,H,W) metres[, z0]) -> depth (B,H,W)`."""
 
     exported: jax.export.Exported
+    name: str = "exported"
 
     @property
     def input_shape(self) -> tuple[int, int, int]:
@@ -130,7 +132,7 @@ def load_exported(path: str | os.PathLike) -> ExportedCompleter:
     except Exception as exc:  # noqa: BLE001 - flatbuffer / version errors all mean "not a usable export file"
         raise ValueError(f"{os.fspath(path)!r} is not a jax.export file this jax can read "
                          f"({type(exc).__name__}: {exc})") from exc
-    return ExportedCompleter(exported)
+    return ExportedCompleter(exported, pathlib.Path(path).stem)
 
 
 def export_format(path: str | os.PathLike) -> str:

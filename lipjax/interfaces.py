@@ -14,7 +14,7 @@ Depth ranges: each meaning of "max depth" has one home.
 from __future__ import annotations
 
 import abc
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import jax
 import numpy as np
@@ -108,3 +108,20 @@ class LearnedModel(abc.ABC):
     def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
         """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse metres; none by default."""
         return {}
+
+
+@runtime_checkable
+class DepthCompleter(Protocol):
+    """Anything that completes depth, classical or learned: the one completer interface.
+
+        completer(rgb: (H, W, 3) uint8, sparse: (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
+
+    with a `name` (the row label of result tables). The classical fills (lipjax.classical), LIP+Wavelet, a loaded
+    learned model (`lipjax.inference.Completer`: LIP or an end-to-end network, also taking batches, with its
+    `parameter_count()` and its config's `max_depth_m`) and an exported model (`lipjax.export.ExportedCompleter`) are
+    completers; `lipjax.methods.get_completer` builds any of them by name. Inputs are checked by lipjax.inputs.
+    """
+
+    name: str
+
+    def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray: ...

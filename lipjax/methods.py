@@ -31,7 +31,7 @@ from lipjax.classical import (
     LinearFill,
     NearestFill,
 )
-from lipjax.classical.completer import DepthCompleter
+from lipjax.interfaces import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
 from lipjax.inference import Completer, complete_frame, default_model, load_model
 from lipjax.inputs import suggest_scene

@@ -2,9 +2,9 @@ import numpy as np
 import pytest
 from scipy import interpolate
 
+from lipjax.interfaces import DepthCompleter
 from lipjax.classical import (
     ColorizationFill,
-    DepthCompleter,
     LinearFill,
     NearestFill,
     nearest_fill,

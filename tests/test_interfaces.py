@@ -36,3 +36,17 @@ def test_the_registry_names_every_hand_crafted_method():
     assert {"nearest", "linear", "ip_basic", "ip_basic_multiscale", "ip_basic_adaptive", "colorization",
             "lip-wavelet"} == set(methods.CLASSICAL)
     assert set(methods.CLASSICAL) <= set(methods.available_methods("indoor"))
+
+
+def test_every_kind_of_completer_implements_the_one_protocol(tmp_path):
+    from lipjax.export import export_completer, load_exported, save_exported
+    from lipjax.inference import Completer
+    from lipjax.interfaces import DepthCompleter
+    from lipjax.methods import get_completer
+
+    model = Completer.random()
+    for completer in (get_completer("linear"), get_completer("lip-wavelet"), model):
+        assert isinstance(completer, DepthCompleter), completer
+    path = save_exported(export_completer(model, 1, 16, 24), tmp_path / "m.stablehlo")
+    exported = load_exported(path)
+    assert isinstance(exported, DepthCompleter) and exported.name == "m"

@@ -1,4 +1,4 @@
-"""Hand-crafted depth completers: no learned parameters, all `DepthCompleter`s (lipjax.classical.completer); by
+"""Hand-crafted depth completers: no learned parameters, all `DepthCompleter`s (lipjax.interfaces); by
 name through the one resolver, lipjax.methods.get_completer:
 
     completer(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
@@ -20,7 +20,6 @@ mismatched shapes, NaN / inf or negative depth.
 from __future__ import annotations
 
 from lipjax.classical.colorization import ColorizationFill, colorization_fill
-from lipjax.classical.completer import DepthCompleter
 from lipjax.classical.interpolate import LinearFill, linear_fill
 from lipjax.classical.ipbasic import (
     IPBasicAdaptiveFill,
@@ -34,7 +33,6 @@ from lipjax.classical.nearest import NearestFill, nearest_fill
 
 __all__ = [
     "ColorizationFill",
-    "DepthCompleter",
     "IPBasicAdaptiveFill",
     "IPBasicFill",
     "IPBasicMultiscaleFill",
