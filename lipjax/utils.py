@@ -25,6 +25,16 @@ def enable_compilation_cache(path: str | os.PathLike | None = None) -> pathlib.P
     return path
 
 
+def die_with_parent() -> None:
+    """Asks Linux to send this process SIGTERM when its parent dies, even by SIGKILL (prctl PR_SET_PDEATHSIG), so
+    that a worker process never outlives the run that started it; elsewhere does nothing."""
+    if sys.platform == "linux":
+        import ctypes
+        import signal
+
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
+
+
 def limit_cpu_threads(n: int) -> set[int]:
     """Runs this process on `n` CPU cores: pins every thread of it (and so every thread it starts later) to `n` of
     the cores it may use now, as `taskset` does (Linux), and sets OpenCV's thread count to `n`. Returns the cores.

@@ -365,3 +365,49 @@ def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_
     other = dataclasses.replace(CONFIG.model, num_iterations=2)  # one more prox: another parameter tree
     with pytest.raises(ValueError, match="do not fit"):
         loop._initial_g_params(dataclasses.replace(CONFIG, model=other, init_from=str(tmp_path / "indoor")))
+
+
+# A run long enough to be killed mid-way (the straight CONFIG ends within a second of compiling), with one loader
+# worker process, checkpoints every 3 steps.
+KILLED = dataclasses.replace(CONFIG, name="killed", g_steps=24, d_steps=0, adv_steps=0, checkpoint_every=3,
+                             data=dataclasses.replace(CONFIG.data, num_workers=1))
+
+
+@pytest.fixture(scope="module")
+def killed_reference(tmp_path_factory):
+    return loop.train(KILLED, tmp_path_factory.mktemp("killed-straight"), progress=False)
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+@pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT], ids=["kill", "term", "int"])
+def test_a_run_killed_at_a_random_step_resumes_bit_identical_and_leaves_no_process(killed_reference, tmp_path,
+                                                                                   signum):
+    """A real training process killed at a random step (seeded: the same step every run of the suite) by SIGKILL
+    (nothing saved: resume from the last periodic checkpoint), SIGTERM or Ctrl-C (the step in progress saved) resumes
+    to parameters and optimiser state bit-identical to an uninterrupted run, and none of its processes outlives it."""
+    kill_after = int(np.random.default_rng(int(signum)).integers(2, KILLED.total_steps - 4))
+    workdir = tmp_path / "run"
+    script = ("import sys; from tests.test_train import KILLED; from lipjax.train import loop; "
+              "loop.train(KILLED, sys.argv[1], progress=False)")
+    proc = subprocess.Popen([sys.executable, "-c", script, str(workdir)], cwd=pathlib.Path(__file__).parents[1],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    metrics = workdir / "metrics.jsonl"
+    try:
+        deadline = time.time() + 240
+        while not (metrics.exists() and metrics.read_text().count("\n") >= kill_after) and time.time() < deadline:
+            time.sleep(0.02)
+        family = _children(proc.pid) | {proc.pid}
+        os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
+        proc.wait(timeout=60)
+    finally:
+        proc.kill()
+    logged = metrics.read_text().count("\n")
+    assert logged < KILLED.total_steps, "the run ended before the kill: nothing was tested"
+    deadline = time.time() + 20
+    while [p for p in family if _alive(p)] and time.time() < deadline:
+        time.sleep(0.2)
+    assert not [p for p in family if _alive(p)], "a process of the killed run outlived it"
+    resumed = loop.train(KILLED, workdir, progress=False)
+    assert int(resumed.step) == KILLED.total_steps
+    assert _leaves_equal(killed_reference.g_params, resumed.g_params)
+    assert _leaves_equal(killed_reference.g_opt_state, resumed.g_opt_state)

@@ -39,6 +39,7 @@ import numpy as np
 from lipjax.data.errors import dataset_error
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import example_rng
+from lipjax.utils import die_with_parent
 
 FORMAT = "lipjax-rendered-v1"
 INDEX = "index.json"
@@ -141,10 +142,7 @@ def _render_worker_init() -> None:
     """A render worker ignores SIGINT (a terminal's Ctrl-C reaches the whole process group; the parent stops the
     workers) and, on Linux, gets SIGTERM when its parent dies, even by SIGKILL: no worker outlives the render."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    if sys.platform == "linux":
-        import ctypes
-
-        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
+    die_with_parent()
 
 
 @contextlib.contextmanager
