@@ -35,6 +35,23 @@ def die_with_parent() -> None:
         ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
 
 
+def exit_when_orphaned(poll_s: float = 0.5) -> None:
+    """Ends this process (exit status 0, no cleanup) once its parent has died, e.g. by SIGKILL: a daemon thread checks
+    every `poll_s` seconds whether the parent pid changed. For worker processes whose parent stops them gracefully
+    otherwise (PR_SET_PDEATHSIG would fire on the exit of the parent's creating thread, not of the process)."""
+    import threading
+    import time
+
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(poll_s)
+        os._exit(0)
+
+    threading.Thread(target=watch, name="exit-when-orphaned", daemon=True).start()
+
+
 def limit_cpu_threads(n: int) -> set[int]:
     """Runs this process on `n` CPU cores: pins every thread of it (and so every thread it starts later) to `n` of
     the cores it may use now, as `taskset` does (Linux), and sets OpenCV's thread count to `n`. Returns the cores.

@@ -30,7 +30,7 @@ import numpy as np
 from lipjax.data.augment import Augment, augment_batch
 from lipjax.data.sample import Batch, Sample
 from lipjax.data.sampling import SparseSampler
-from lipjax.utils import die_with_parent
+from lipjax.utils import exit_when_orphaned
 
 DATA_AXIS = "data"
 EVAL_BATCH_SIZE = 4
@@ -199,14 +199,14 @@ def _single_threaded_worker(worker_index: int, worker_count: int) -> None:
     """Each worker process uses one core: OpenCV's own thread pool would make the workers compete for cores.
     Workers ignore SIGINT: a terminal's Ctrl-C reaches the whole process group, and the training loop, not each
     worker, decides what it means (lipjax.train.loop: save the step in progress, then stop the workers). A worker
-    ends with the run even when the run is killed (SIGKILL): `lipjax.utils.die_with_parent`."""
+    ends with the run even when the run is killed (SIGKILL): `lipjax.utils.exit_when_orphaned`."""
     import signal
 
     import cv2
 
     cv2.setNumThreads(1)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    die_with_parent()
+    exit_when_orphaned()
 
 
 class TrainLoader:

@@ -80,8 +80,9 @@ def _initial_g_params(config: TrainConfig):
             raise ValueError(f"init_from {config.init_from!r} has model config {init_config}, whose parameters do "
                              f"not fit this run's {config.model}; train from scratch with --set init_from=None or "
                              "pick a model of the same architecture")
+        had = {f.name: getattr(init_config, f.name) for f in dataclasses.fields(init_config)}
         differ = [f.name for f in dataclasses.fields(config.model)
-                  if getattr(init_config, f.name, None) != getattr(config.model, f.name)]
+                  if f.name not in had or had[f.name] != getattr(config.model, f.name)]
         print(f"[lipjax] init_from {config.init_from!r}: its parameters, this run's settings of {differ}")
     return params
 
