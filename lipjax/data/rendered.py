@@ -147,16 +147,19 @@ def _render_worker_init() -> None:
 
 @contextlib.contextmanager
 def _sigterm_as_exit():
-    """SIGTERM raises SystemExit(143) in the main thread while rendering (Ctrl-C raises KeyboardInterrupt already),
-    so that the worker processes are stopped on the way out. No-op outside the main thread."""
+    """SIGTERM raises SystemExit(143) and Ctrl-C KeyboardInterrupt in the main thread while rendering, so that the
+    worker processes are stopped on the way out; Ctrl-C does so even in a process started with SIGINT ignored (as
+    `nohup` and background jobs of scripts start). No-op outside the main thread."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous_int)
 
 
 def _index(spec: RenderSpec) -> dict:
