@@ -9,7 +9,8 @@ table gives the geometric-mean RMSE ratio to the full-size linear fill on the un
 wins).
 
 The rule, fixed before any real frame is scored: (TARGET_SPACING_PX, MAX_WORKING_PIXELS) is the (T, P) with the
-lowest geometric mean over all the settings together. Real frames are scored afterwards, with that T (benchmarks/real_frames.py).
+lowest geometric mean over all the settings together. Real frames are scored afterwards, with that rule
+(benchmarks/real_frames.py).
 """
 from __future__ import annotations
 
@@ -82,7 +83,8 @@ def main(argv=None) -> None:
     names = [_name(rule) for rule in RULES]
     overall = {n: float(np.exp(np.mean([np.log(row[n]) for row in table.values()]))) for n in names}
     best = min(overall, key=overall.get)
-    print("\nGeometric-mean RMSE ratio to linear over all settings; rows T (target spacing px), columns P (max pixels):")
+    print("\nGeometric-mean RMSE ratio to linear over all settings; rows T (target spacing px), columns P (max "
+          "pixels):")
     print("| T \\ P | " + " | ".join(n.split(",")[1] for n in names[:len(MAX_PIXELS)]) + " |")
     print("|---|" + "---|" * len(MAX_PIXELS))
     for i in range(len(TARGETS_PX)):

@@ -92,9 +92,10 @@ COMPLETE_HELP = """\
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
 in training, at most 60,000 pixels (200 points on 640x480 run at 283x212; a 64-beam KITTI scan at 455x132); a
-new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the pixel of the
-small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never averaged);
-the result is resized back (bilinear) and the measured pixels are then set to their measured values exactly.
+new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
+pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
+averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured values
+exactly.
 `--max-side N` overrides the working size: the longer side becomes at most N pixels.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
