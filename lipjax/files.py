@@ -305,8 +305,7 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
     h, w = frame_size(completer, sparse, max_side)
     if max_side is None and h * w > inference.LARGE_FRAME_PIXELS:  # read here: tests lower it
         warnings.warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) "
-                      "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized "
-                      "(--max-side 416 with the shipped outdoor models, their training scale)", stacklevel=2)
+                      "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized", stacklevel=2)
     return completer
 
 

@@ -1,8 +1,8 @@
 """The jit-compiled inference entry point: `Completer` (a model with its parameters); inputs checked by lipjax.inputs.
 
 Also `load_model` (a saved model by name or path), `default_model` (the shipped default of a scene), and
-`complete_frame`, which runs a learned model at its working size (lipjax.resolution) and returns full-size depth. Names of every kind of completer
-(learned, classical, a path) resolve in lipjax.methods.get_completer.
+`complete_frame`, which runs a learned model at its working size (lipjax.resolution) and returns full-size depth.
+Names of every kind of completer (learned, classical, a path) resolve in lipjax.methods.get_completer.
 
 `Completer.__call__` takes RGB uint8 (H, W, 3) or (B, H, W, 3) and sparse depth in metres (0 = missing) of the
 same size, and returns dense depth in metres. The solver is compiled once per (config, input shape): jit caches

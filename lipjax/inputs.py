@@ -189,7 +189,10 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
     elif not lidar and density > DENSE and samples.max() <= KINECT_AT_256_M:
         _warn(f"a dense depth map within {KINECT_AT_256_M:.0f} m: a millimetre PNG (Kinect, NYU) read with "
               f"--depth-scale 256 (use 1000), or indoor data (use {_other_model(name, 'indoor')})?")
-    trained = min(TRAINED_MIN_DENSITY.values()) if both_scenes else TRAINED_MIN_DENSITY["indoor" if indoor else "outdoor"]
+    if both_scenes:  # the sparser of the two scenes' inputs
+        trained = min(TRAINED_MIN_DENSITY.values())
+    else:
+        trained = TRAINED_MIN_DENSITY["indoor" if indoor else "outdoor"]
     if density < trained / 4:
         _warn(f"samples on under a quarter as many pixels as in the sparsest input {name} was trained on "
               f"({100 * trained:.2g} % of the pixels): expect larger errors")

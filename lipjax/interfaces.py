@@ -28,34 +28,31 @@ SCENE_MAX_DEPTH_M: dict[str, float] = {"indoor": 10.0, "outdoor": 85.0}
 MIXED_SCENES = "mixed"
 
 MODEL_TYPES: dict[str, type] = {}
-
-
-def register_model_type(name: str):
-    """Class decorator: records a LearnedModel subclass under `name`, the type name written in model files."""
-
-    def register(cls: type) -> type:
-        if name in MODEL_TYPES and MODEL_TYPES[name] is not cls:
-            raise ValueError(f"model type {name!r} is already registered to {MODEL_TYPES[name].__name__}")
-        MODEL_TYPES[name] = cls
-        return cls
-
-    return register
-
-
 # Prior (prox) config types by the name written in model files ("prior_type"), filled by `register_prior_type`.
 PRIOR_TYPES: dict[str, type] = {}
 
 
-def register_prior_type(name: str):
-    """Class decorator: records a prior config class (lipjax.priors) under `name`, the prior type in model files."""
+def _registrar(table: dict[str, type], what: str, name: str):
+    """Class decorator recording a class in `table` under `name` (a `what`, e.g. "model type"); a second class under
+    the same name is an error."""
 
     def register(cls: type) -> type:
-        if name in PRIOR_TYPES and PRIOR_TYPES[name] is not cls:
-            raise ValueError(f"prior type {name!r} is already registered to {PRIOR_TYPES[name].__name__}")
-        PRIOR_TYPES[name] = cls
+        if name in table and table[name] is not cls:
+            raise ValueError(f"{what} {name!r} is already registered to {table[name].__name__}")
+        table[name] = cls
         return cls
 
     return register
+
+
+def register_model_type(name: str):
+    """Class decorator: records a LearnedModel subclass under `name`, the type name written in model files."""
+    return _registrar(MODEL_TYPES, "model type", name)
+
+
+def register_prior_type(name: str):
+    """Class decorator: records a prior config class (lipjax.priors) under `name`, the prior type in model files."""
+    return _registrar(PRIOR_TYPES, "prior type", name)
 
 
 def parameter_count(params: Params) -> int:

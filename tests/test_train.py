@@ -252,17 +252,18 @@ def _children(pid: int) -> set[int]:
     return kids
 
 
-@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
-def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
-    """A killed run (SIGTERM) saves the step it was in, although no checkpoint was due, exits with 143 and takes
-    its loader worker processes with it, leaving no shared memory behind; the checkpoint restores at that step,
-    with its data position."""
+def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[int], list[int], list[int], str]:
+    """Starts `experiments.train --config smoke` (2 loader workers, no checkpoint due) in a process group of its
+    own, as a terminal's foreground job, and sends `signum` once it has logged 2 steps: to the process (SIGTERM) or
+    to its whole group (SIGINT, as Ctrl-C). Returns (exit status, the loader worker pids, the logged steps, the
+    saved checkpoint steps, its output)."""
     workdir = tmp_path / "run"
     cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
            "--set", "g_steps=100000", "--set", "data.num_workers=2", "--set", "checkpoint_every=100000",
            "--set", "log_every=1", "--set", "eval_every=0"]
     with open(tmp_path / "out.txt", "w") as out:
-        proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT)
+        proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT,
+                                start_new_session=True)
     metrics = workdir / "metrics.jsonl"
     try:
         deadline = time.time() + 240
@@ -270,22 +271,35 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
             time.sleep(0.2)
         workers = _children(proc.pid)
         assert workers, "the run should have a loader worker process"
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=60) == 143
+        os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
+        status = proc.wait(timeout=60)
     finally:
         proc.kill()
     logged = [json.loads(line)["step"] for line in metrics.read_text().splitlines()]
     saved = [int(p.name) for p in (workdir / "checkpoints").glob("[0-9]*")]
-    assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
+    return status, workers, logged, saved, (tmp_path / "out.txt").read_text()
+
+
+def _workers_end(workers: set[int]) -> bool:
     deadline = time.time() + 20
     while [w for w in workers if _alive(w)] and time.time() < deadline:
         time.sleep(0.2)
-    assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
-    text = (tmp_path / "out.txt").read_text()
+    return not [w for w in workers if _alive(w)]
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
+    """A killed run (SIGTERM) saves the step it was in, although no checkpoint was due, exits with 143 and takes
+    its loader worker processes with it, leaving no shared memory behind; the checkpoint restores at that step,
+    with its data position."""
+    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGTERM)
+    assert status == 143
+    assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
+    assert _workers_end(workers), "loader workers outlived the run"
     assert "leaked shared_memory" not in text and "Traceback" not in text, text[-3000:]
     from experiments.configs import get_config
 
-    manager = CheckpointManager(workdir / "checkpoints")
+    manager = CheckpointManager(tmp_path / "run" / "checkpoints")
     state, meta = manager.restore(init_state(get_config("smoke")))  # what a resumed run starts from
     manager.close()
     assert int(state.step) == meta["data_position"] == saved[0] and meta["data_loader"]["next_step"] == saved[0]
@@ -296,35 +310,13 @@ def test_ctrl_c_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pat
     """Ctrl-C as a terminal sends it (SIGINT to the whole process group, loader workers included) saves the step
     in progress, although no checkpoint was due, says so, exits with 130, and the workers end with the run,
     leaving no shared memory behind."""
-    workdir = tmp_path / "run"
-    cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
-           "--set", "g_steps=100000", "--set", "data.num_workers=2", "--set", "checkpoint_every=100000",
-           "--set", "log_every=1", "--set", "eval_every=0"]
-    with open(tmp_path / "out.txt", "w") as out:
-        proc = subprocess.Popen(cmd, cwd=pathlib.Path(__file__).parents[1], stdout=out, stderr=subprocess.STDOUT,
-                                start_new_session=True)  # its own process group, as a terminal's foreground job
-    metrics = workdir / "metrics.jsonl"
-    try:
-        deadline = time.time() + 240
-        while not (metrics.exists() and metrics.read_text().count("\n") >= 2) and time.time() < deadline:
-            time.sleep(0.2)
-        workers = _children(proc.pid)
-        assert workers, "the run should have a loader worker process"
-        os.killpg(proc.pid, signal.SIGINT)
-        assert proc.wait(timeout=60) == 130
-    finally:
-        proc.kill()
-    logged = [json.loads(line)["step"] for line in metrics.read_text().splitlines()]
-    saved = [int(p.name) for p in (workdir / "checkpoints").glob("[0-9]*")]
+    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGINT)
+    assert status == 130
     assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
-    text = (tmp_path / "out.txt").read_text()
-    said = f"[lipjax] SIGINT: saved step {saved[0]} in {workdir / 'checkpoints'}; stopping (run again to resume)"
-    assert said in text
+    checkpoints = tmp_path / "run" / "checkpoints"
+    assert f"[lipjax] SIGINT: saved step {saved[0]} in {checkpoints}; stopping (run again to resume)" in text
     assert "Traceback" not in text and "leaked shared_memory" not in text, text[-3000:]
-    deadline = time.time() + 20
-    while [w for w in workers if _alive(w)] and time.time() < deadline:
-        time.sleep(0.2)
-    assert not [w for w in workers if _alive(w)], "loader workers outlived the run"
+    assert _workers_end(workers), "loader workers outlived the run"
 
 
 def test_a_second_signal_exits_at_once_and_the_handlers_are_restored():
