@@ -14,7 +14,11 @@ What each part is for (real sensors and real frames differ from the synthetic re
 - horizontal flip (geometry stays valid for a pinhole camera; the scenes have no left/right bias);
 - photometric jitter: brightness, contrast and saturation factors in [1 - a, 1 + a] and gamma in
   [1 / (1 + g), 1 + g] (camera exposure, white balance, tone curves);
-- Gaussian blur with probability `blur_prob`, sigma up to `blur_sigma_px` pixels (defocus, motion, JPEG);
+- Gaussian blur with probability `blur_prob`, sigma up to `blur_sigma_px` pixels (defocus, motion);
+- camera noise: per-pixel Gaussian noise of standard deviation up to `sensor_noise` (fraction of full scale),
+  then with probability `jpeg_prob` a JPEG round trip at quality 30-95 (`camera_noise`): photographs carry shot
+  noise and compression blocks, the renders are clean, so a prox trained on clean renders reads every small
+  colour step as structure;
 - sensor noise: every sample's depth times (1 + n), n ~ N(0, depth_noise) (LiDAR range noise is roughly
   proportional to range at these scales);
 - outliers: a fraction of the samples pushed behind their true depth by a factor in [1.1, 3] (the LiDAR and the
@@ -54,6 +58,8 @@ class Augment:
     outlier_fraction: float = 0.0
     texture_prob: float = 0.0
     texture_strength: float = 0.4
+    sensor_noise: float = 0.0
+    jpeg_prob: float = 0.0
 
     def __post_init__(self):
         lo, hi = self.zoom
@@ -64,6 +70,8 @@ class Augment:
                 raise ValueError(f"{name} must be in [0, 1), got {getattr(self, name)}")
         if not (0 <= self.blur_prob <= 1 and 0 <= self.outlier_fraction <= 1 and 0 <= self.texture_prob <= 1):
             raise ValueError("blur_prob, outlier_fraction and texture_prob are probabilities in [0, 1]")
+        if not (0 <= self.sensor_noise < 1 and 0 <= self.jpeg_prob <= 1):
+            raise ValueError("sensor_noise must be in [0, 1) and jpeg_prob in [0, 1]")
         if not 0 <= self.texture_strength < 1:
             raise ValueError(f"texture_strength must be in [0, 1), got {self.texture_strength}")
         if self.gamma < 0 or self.depth_noise < 0 or self.blur_sigma_px <= 0:
@@ -155,6 +163,24 @@ def paint_texture(rgb: np.ndarray, strength: float, rng: np.random.Generator) ->
     return np.clip(np.round(out), 0, 255).astype(np.uint8)
 
 
+JPEG_QUALITY = (30, 95)  # range of the JPEG round trip's quality setting
+
+
+def camera_noise(rgb: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.ndarray:
+    """(H, W, 3) uint8 -> uint8 with Gaussian noise of std U(0, sensor_noise) * 255 and, with probability
+    jpeg_prob, a JPEG encode-decode at a quality drawn in JPEG_QUALITY."""
+    out = rgb
+    if aug.sensor_noise:
+        sigma = rng.uniform(0, aug.sensor_noise) * 255.0
+        noisy = rgb.astype(np.float32) + sigma * rng.standard_normal(rgb.shape).astype(np.float32)
+        out = np.clip(np.round(noisy), 0, 255).astype(np.uint8)
+    if aug.jpeg_prob and rng.random() < aug.jpeg_prob:
+        quality = int(rng.integers(JPEG_QUALITY[0], JPEG_QUALITY[1] + 1))
+        ok, code = cv2.imencode(".jpg", np.ascontiguousarray(out), [cv2.IMWRITE_JPEG_QUALITY, quality])
+        out = cv2.imdecode(code, cv2.IMREAD_UNCHANGED).reshape(rgb.shape) if ok else out
+    return out
+
+
 def perturb_samples(sparse: np.ndarray, aug: Augment, rng: np.random.Generator) -> np.ndarray:
     """Sensor noise and bleed-through outliers on the samples of (H, W) sparse depth in metres (0 stays 0)."""
     out = sparse.copy()
@@ -182,6 +208,8 @@ def augment_example(rgb, sparse, gt, valid, crop, aug: Augment, rng: np.random.G
         rgb = photometric(rgb, aug, rng)
     if aug.blur_prob and rng.random() < aug.blur_prob:
         rgb = cv2.GaussianBlur(np.ascontiguousarray(rgb), (0, 0), rng.uniform(0.3, aug.blur_sigma_px))
+    if aug.sensor_noise or aug.jpeg_prob:
+        rgb = camera_noise(np.ascontiguousarray(rgb), aug, rng)
     if aug.depth_noise or aug.outlier_fraction:
         sparse = perturb_samples(sparse, aug, rng)
     return tuple(np.ascontiguousarray(a) for a in (rgb, sparse, gt, valid))
