@@ -44,7 +44,7 @@ from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
 from lipjax.pointcloud import IntrinsicsLike, backproject_rgbd, write_ply
-from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported, write_uncertainty
+from lipjax.uncertainty import drop_uncertain, expected_error, support_mask, write_uncertainty
 from lipjax.viz import fitting_range
 
 DEFAULT_PNG_OUT_SCALE = 256.0
@@ -233,10 +233,10 @@ class _Output:
             if self.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, self.max_uncertainty)
         if not self.fill_all:
-            masked = mask_unsupported(dense, sparse)
-            self.unsupported += int(((masked == 0) & (dense > 0)).sum())
+            unsupported = ~support_mask(sparse)
+            self.unsupported += int(np.count_nonzero(dense[unsupported] > 0))
             self.pixels += dense.size
-            dense = masked
+            dense = np.where(unsupported, np.float32(0), dense)
         if self.color_range is None:
             self.color_range, self.fitted = fitting_range(dense, self.max_depth_m), self.fmt == "color.png"
         write_depth(job.out, dense, self.fmt, self.png_scale, self.color_range)
