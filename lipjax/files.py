@@ -234,7 +234,7 @@ class _Output:
                 dense = drop_uncertain(dense, u, self.max_uncertainty)
         if not self.fill_all:
             unsupported = ~support_mask(sparse)
-            self.unsupported += int(np.count_nonzero(dense[unsupported] > 0))
+            self.unsupported += int(np.count_nonzero(unsupported & (dense > 0)))
             self.pixels += dense.size
             dense = np.where(unsupported, np.float32(0), dense)
         if self.color_range is None:
