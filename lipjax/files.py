@@ -8,11 +8,15 @@
 Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
 --help describes the formats), and its errors name those flags.
 
-A folder runs close to the model's own rate (100 KITTI-size frames on 2 cores: 0.73x the warm single-frame rate,
-benchmarks/folder_speed.py): worker threads read and decode the next frames (OpenCV and numpy's file reads release
-the GIL) while the model runs on the current one in the calling thread, and one background thread
-post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is loaded
-once and compiled once per frame shape (jax.jit caches one executable per shape). Every output file is written
+A folder overlaps reading, the model and writing: worker threads read and decode the next frames (OpenCV and
+numpy's file reads release the GIL) while the model runs on the current one in the calling thread, and one background
+thread post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is
+loaded once and compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames
+(`python -m benchmarks.folder_speed`, 2 cores shared with a training run, load average 6-9) a folder ran at 16
+frames/s, 0.72x the warm single-frame rate (median of 15 runs, 0.53-0.94, 5 of them at 0.8 or more; 10 runs of
+the code before, interleaved with them: 12 frames/s, 0.52x). Per frame the model takes 37 ms of CPU, and a folder
+adds 17.5 ms that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1 (18.9 before);
+when the process gets one core in all, that bounds the ratio at 37 / 54.6 = 0.68. Every output file is written
 under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an
 unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the frames after
 it.
@@ -44,7 +48,7 @@ from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
 from lipjax.pointcloud import IntrinsicsLike, backproject_rgbd, write_ply
-from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported, write_uncertainty
+from lipjax.uncertainty import drop_uncertain, expected_error, support_mask, write_uncertainty
 from lipjax.viz import fitting_range
 
 DEFAULT_PNG_OUT_SCALE = 256.0
@@ -233,10 +237,10 @@ class _Output:
             if self.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, self.max_uncertainty)
         if not self.fill_all:
-            masked = mask_unsupported(dense, sparse)
-            self.unsupported += int(((masked == 0) & (dense > 0)).sum())
+            unsupported = ~support_mask(sparse)
+            self.unsupported += int(np.count_nonzero(unsupported & (dense > 0)))
             self.pixels += dense.size
-            dense = masked
+            dense = np.where(unsupported, np.float32(0), dense)
         if self.color_range is None:
             self.color_range, self.fitted = fitting_range(dense, self.max_depth_m), self.fmt == "color.png"
         write_depth(job.out, dense, self.fmt, self.png_scale, self.color_range)

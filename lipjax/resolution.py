@@ -39,7 +39,10 @@ MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cos
 
 
 def sample_spacing_px(sparse_m: np.ndarray) -> float:
-    """Mean spacing of the samples of a (H, W) sparse depth map (0 = none), in pixels: sqrt(H W / n); inf for n = 0."""
+    """Mean spacing of the samples of a (H, W) sparse depth map (0 = none), in pixels: sqrt(H W / n); inf for n = 0.
+
+    Over the whole frame (TARGET_SPACING_PX was chosen by it); lipjax.uncertainty.sample_spacing is the spacing within
+    the samples' bounding box (where a scan's samples are), for the support rules."""
     n = int(np.count_nonzero(np.asarray(sparse_m) > 0))
     h, w = np.shape(sparse_m)[-2:]
     return math.sqrt(h * w / n) if n else math.inf

@@ -237,3 +237,62 @@ def test_support_mask_follows_its_rule_in_pixels():
     rng = np.random.default_rng(0)
     scattered = np.where(rng.random((30, 50)) < 0.03, rng.uniform(1, 5, (30, 50)), 0).astype(np.float32)
     np.testing.assert_array_equal(uncertainty.support_mask(scattered), _support_by_hand(scattered))
+
+
+def _support_exactly(sparse):
+    """support_mask's rule pixel by pixel in exact arithmetic: s ** 2 = max(area, n) / n as a fraction; a pixel t
+    rows above the highest sample of the columns within ceil(2 s) either side is within when t <= 1 s, and one k
+    square pixels from its nearest sample when k <= (3 s) ** 2."""
+    from fractions import Fraction
+
+    h, w = sparse.shape
+    rows, cols = np.nonzero(sparse > 0)
+    area, n = (np.ptp(rows) + 1) * (np.ptp(cols) + 1), rows.size
+    s2 = Fraction(int(max(area, n)), n)
+    reach = math.ceil(2 * math.sqrt(s2))
+    first = [rows[cols == c].min() if (cols == c).any() else h for c in range(w)]
+    out = np.zeros((h, w), bool)
+    for r in range(h):
+        for c in range(w):
+            t = min(first[max(0, c - reach):c + reach + 1]) - r
+            k = int(((rows - r) ** 2 + (cols - c) ** 2).min())
+            out[r, c] = (t <= 0 or t * t <= Fraction(uncertainty.ABOVE_SPACINGS) ** 2 * s2) and \
+                k <= Fraction(uncertainty.REACH_SPACINGS) ** 2 * s2
+    return out
+
+
+def _scan_lines(rng, h, w):
+    """LiDAR-like samples: rows every 2-3 pixels from a random first row, 15 % dropped, a beam-less block of
+    columns and a hole."""
+    sparse = np.zeros((h, w), np.float32)
+    sparse[rng.integers(0, h // 2)::rng.integers(2, 4)] = rng.uniform(2, 80, w)
+    sparse[rng.random((h, w)) < 0.15] = 0
+    c = rng.integers(0, w - 8)
+    sparse[:h // 2 + 5, c:c + 8] = 0
+    r, c = rng.integers(0, h - 6), rng.integers(0, w - 10)
+    sparse[r:r + 6, c:c + 10] = 0
+    return sparse
+
+
+def test_support_mask_equals_the_rule_in_exact_arithmetic():
+    """The distance transform and the per-column limits give the rule's mask exactly: scattered samples of several
+    densities, scan lines with gaps, a band of samples whose reach ends in mid-frame (an approximate distance, as
+    OpenCV's 5x5 mask, fails it), samples on the first row, one sample, and a frame whose reach is a tie (9 samples
+    in a 2x5 box: s ** 2 = 10 / 9, so a pixel sqrt(10) px from the box is exactly 3 s away)."""
+    rng = np.random.default_rng(0)
+    frames = [np.where(rng.random((30, 44)) < p, rng.uniform(1, 9, (30, 44)), 0) for p in (0.004, 0.03, 0.25)]
+    frames += [_scan_lines(rng, 40, 64) for _ in range(4)]
+    band = np.zeros((64, 96))  # 16 samples in the top 10 rows: s = 7.5 px, so the reach (22.5 px) ends mid-frame
+    band[rng.integers(0, 10, 16), rng.integers(0, 96, 16)] = 4.0
+    frames.append(band)
+    first_row = np.zeros((20, 30))
+    first_row[0, ::3] = 5.0
+    one = np.zeros((15, 17))
+    one[7, 2] = 3.0
+    tie = np.zeros((20, 24))
+    tie[10:12, 10:15] = 5.0
+    tie[10, 10] = 0.0
+    for sparse in frames + [first_row, one, tie]:
+        sparse = sparse.astype(np.float32)
+        np.testing.assert_array_equal(uncertainty.support_mask(sparse), _support_exactly(sparse))
+    assert uncertainty.support_mask(tie)[12, 17] and not uncertainty.support_mask(tie)[12, 18]
