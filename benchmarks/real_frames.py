@@ -32,6 +32,7 @@ from benchmarks.baselines import _png_depth, _rgb, load_kitti, load_middlebury, 
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.inference import complete_at, complete_frame, frame_size  # noqa: E402
+from lipjax.inputs import is_lidar_pattern  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
 
@@ -102,10 +103,10 @@ def main(argv=None) -> None:
         for method in classical:
             row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
         if args.sweep:
-            spacing = sample_spacing_px(sparse)
+            spacing, lines = sample_spacing_px(sparse), is_lidar_pattern(sparse)
             row["sweep"] = {
-                str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(sample.shape, spacing, t)), sample,
-                             sparse) / ref for t in SWEEP_TARGETS_PX}
+                str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(sample.shape, spacing, t, lines)),
+                             sample, sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
         print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "
@@ -132,9 +133,9 @@ def main(argv=None) -> None:
         print(f"\nwrote {args.json}")
 
 
-def _sweep_size(shape: tuple[int, int], spacing: float, target: float) -> tuple[int, int]:
-    """The working size with target spacing `target` (and the pixel cap); `target` >= 1e9: the native size."""
-    return tuple(shape) if target >= 1e9 else working_size(shape, spacing, target)
+def _sweep_size(shape: tuple[int, int], spacing: float, target: float, scan_lines: bool) -> tuple[int, int]:
+    """The working size with target spacing `target` (and the pixel cap of the pattern); >= 1e9: the native size."""
+    return tuple(shape) if target >= 1e9 else working_size(shape, spacing, target, scan_lines=scan_lines)
 
 
 def sweep_table(rows: list[dict], plot: str | None) -> None:

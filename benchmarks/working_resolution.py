@@ -3,14 +3,16 @@
     python benchmarks/working_resolution.py [--model lip-fast-indoor] [--frames 12] [--out runs/eval/working_res]
 
 Rooms rendered at 480x640 (NYU's size) and streets at 352x1216 (KITTI's), from the test split (never trained on),
-with 50, 200 and 1,000 uniform points on the rooms and a 64-beam scan or 200 points on the streets. For each target
-spacing T (pixels) and pixel cap P the model runs at `lipjax.resolution.working_size(shape, spacing, T, P)`, and the
-table gives the geometric-mean RMSE ratio to the full-size linear fill on the unsampled valid pixels (< 1: the model
-wins).
+with 50, 200, 1,000 and 5,000 uniform points on the rooms, and 64- and 32-beam scans, 200 points or 25,000 points
+(dense, like 30 % of KITTI's valid pixels) on the streets. For each target spacing T (pixels) and pixel cap P the model
+runs at `lipjax.resolution.working_size(shape, spacing, T, P)`, and the table gives the geometric-mean RMSE ratio to
+the full-size linear fill on the unsampled valid pixels (< 1: the model wins).
 
-The rule, fixed before any real frame is scored: (TARGET_SPACING_PX, MAX_WORKING_PIXELS) is the (T, P) with the
-lowest geometric mean over all the settings together. Real frames are scored afterwards, with that rule
-(benchmarks/real_frames.py).
+The rule, fixed before any real frame is scored: T (TARGET_SPACING_PX) and the pixel cap of scattered samples
+(MAX_WORKING_PIXELS["scattered"]) are the (T, P) with the lowest geometric mean over the scattered settings; the cap
+of LiDAR scan lines (MAX_WORKING_PIXELS["scan_lines"]) is the P with the lowest geometric mean over the scan-line
+settings at that T (`lipjax.inputs.is_lidar_pattern` tells them apart, as the default path does). Real frames are
+scored afterwards, with that rule (benchmarks/real_frames.py).
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from lipjax.data.sampling import sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
 from lipjax.inference import complete_at  # noqa: E402
+from lipjax.inputs import is_lidar_pattern  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
 
@@ -33,11 +36,14 @@ SETTINGS = (  # (kind, height, width, sampler spec)
     ("indoor", 480, 640, "uniform:50"),
     ("indoor", 480, 640, "uniform:200"),
     ("indoor", 480, 640, "uniform:1000"),
+    ("indoor", 480, 640, "uniform:5000"),
     ("outdoor", 352, 1216, "lidar:hdl64"),
+    ("outdoor", 352, 1216, "lidar:vlp32"),
     ("outdoor", 352, 1216, "uniform:200"),
+    ("outdoor", 352, 1216, "uniform:25000"),
 )
 TARGETS_PX = (8.0, 11.0, 16.0, 22.0, 32.0, 1e9)  # 1e9: no spacing rule
-MAX_PIXELS = (40_000, 60_000, 100_000, 150_000, 1e12)  # 1e12: no pixel cap
+MAX_PIXELS = (40_000, 60_000, 100_000, 150_000, 250_000, 1e12)  # 1e12: no pixel cap
 RULES = [(t, p) for t in TARGETS_PX for p in MAX_PIXELS]
 
 
@@ -48,12 +54,13 @@ def rmse_unsampled(pred: np.ndarray, gt: np.ndarray, valid: np.ndarray, sparse: 
 
 def run(model: str, frames: int) -> dict:
     completer, linear = get_completer(model), get_completer("linear")
-    table = {}
+    table, scan_lines = {}, {}
     for kind, h, w, spec in SETTINGS:
         dataset, sampler = SyntheticDataset(kind, "test", size=frames, height=h, width=w), sampler_from_spec(spec)
-        ratios = {rule: [] for rule in RULES}
+        ratios, patterns = {rule: [] for rule in RULES}, set()
         for sample in dataset:
             sparse = sampler(sample, 0)
+            patterns.add(is_lidar_pattern(sparse))
             ref = rmse_unsampled(linear(sample.rgb, sparse), sample.depth, sample.valid, sparse)
             spacing, by_size = sample_spacing_px(sparse), {}
             for t, p in RULES:
@@ -63,9 +70,16 @@ def run(model: str, frames: int) -> dict:
                     by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"
+        if len(patterns) > 1:
+            raise RuntimeError(f"{key}: is_lidar_pattern differs between frames; a setting must be one pattern")
+        scan_lines[key] = patterns.pop()
         table[key] = {_name(rule): float(np.exp(np.mean(np.log(r)))) for rule, r in ratios.items()}
         print(key, {k: round(v, 3) for k, v in table[key].items()}, flush=True)
-    return table
+    return table, scan_lines
+
+
+def _geomean(table: dict, keys: list[str], name: str) -> float:
+    return float(np.exp(np.mean([np.log(table[k][name]) for k in keys])))
 
 
 def _name(rule: tuple[float, float]) -> str:
@@ -79,25 +93,32 @@ def main(argv=None) -> None:
     parser.add_argument("--frames", type=int, default=12)
     parser.add_argument("--out", default="runs/eval/working_resolution")
     args = parser.parse_args(argv)
-    table = run(args.model, args.frames)
+    table, scan_lines = run(args.model, args.frames)
     names = [_name(rule) for rule in RULES]
-    overall = {n: float(np.exp(np.mean([np.log(row[n]) for row in table.values()]))) for n in names}
-    best = min(overall, key=overall.get)
-    print("\nGeometric-mean RMSE ratio to linear over all settings; rows T (target spacing px), columns P (max "
-          "pixels):")
-    print("| T \\ P | " + " | ".join(n.split(",")[1] for n in names[:len(MAX_PIXELS)]) + " |")
-    print("|---|" + "---|" * len(MAX_PIXELS))
-    for i in range(len(TARGETS_PX)):
-        row = names[i * len(MAX_PIXELS):(i + 1) * len(MAX_PIXELS)]
-        print(f"| {row[0].split(',')[0]} | " + " | ".join(f"{overall[n]:.3f}" for n in row) + " |")
-    print("\nPer setting at the best rule and with neither rule (native size):")
+    groups = {"scattered": [k for k in table if not scan_lines[k]], "scan lines": [k for k in table if scan_lines[k]]}
+    overall = {g: {n: _geomean(table, keys, n) for n in names} for g, keys in groups.items() if keys}
+    best_scattered = min(overall["scattered"], key=overall["scattered"].get)
+    target = best_scattered.split(",")[0]
+    at_target = {n: v for n, v in overall.get("scan lines", {}).items() if n.split(",")[0] == target}
+    best_lines = min(at_target, key=at_target.get) if at_target else None
+    for group, values in overall.items():
+        print(f"\n{group}: geometric-mean RMSE ratio to linear; rows T (target spacing px), columns P (max pixels):")
+        print("| T \\ P | " + " | ".join(n.split(",")[1] for n in names[:len(MAX_PIXELS)]) + " |")
+        print("|---|" + "---|" * len(MAX_PIXELS))
+        for i in range(len(TARGETS_PX)):
+            row = names[i * len(MAX_PIXELS):(i + 1) * len(MAX_PIXELS)]
+            print(f"| {row[0].split(',')[0]} | " + " | ".join(f"{values[n]:.3f}" for n in row) + " |")
+    best = {k: best_lines if scan_lines[k] else best_scattered for k in table}
+    print("\nPer setting at the chosen rule and with neither rule (native size):")
     for key, row in table.items():
-        print(f"  {key}: {row[best]:.3f} (native {row['T=inf,P=inf']:.3f})")
-    print(f"\nbest rule: {best} (geometric mean {overall[best]:.3f})")
+        print(f"  {key}: {row[best[key]]:.3f} at {best[key]} (native {row['T=inf,P=inf']:.3f})")
+    chosen = float(np.exp(np.mean([np.log(row[best[k]]) for k, row in table.items()])))
+    print(f"\nchosen: scattered {best_scattered}, scan lines {best_lines}; geometric mean over all settings "
+          f"{chosen:.3f}")
     os.makedirs(args.out, exist_ok=True)
     with open(os.path.join(args.out, "working_resolution.json"), "w") as f:
-        json.dump({"model": args.model, "frames": args.frames, "table": table, "overall": overall, "best": best}, f,
-                  indent=1)
+        json.dump({"model": args.model, "frames": args.frames, "table": table, "scan_lines": scan_lines,
+                   "overall": overall, "scattered": best_scattered, "scan lines": best_lines}, f, indent=1)
 
 
 if __name__ == "__main__":

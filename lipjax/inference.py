@@ -21,7 +21,7 @@ import jax
 import numpy as np
 
 from lipjax import model_io
-from lipjax.inputs import InputError, check_inputs  # noqa: F401  (lipjax.InputError)
+from lipjax.inputs import InputError, check_inputs, is_lidar_pattern  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
@@ -147,7 +147,8 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
     """(h, w) at which `completer` runs on a frame with (H, W) sparse depth `sparse_m` (metres, 0 = none).
 
     `max_side` (pixels, >= MIN_MAX_SIDE_PX) caps the longer side; without it a learned model runs at the
-    working size of its samples' spacing (`lipjax.resolution.working_size`) and a classical fill at full size.
+    working size of its samples' spacing and pattern (`lipjax.resolution.working_size`) and a classical fill at
+    full size.
     """
     shape = tuple(np.shape(sparse_m))
     if max_side is not None:
@@ -158,7 +159,9 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
     if not isinstance(completer, Completer):
         return shape
     spacing = sample_spacing_px(sparse_m)
-    return shape if spacing == float("inf") else working_size(shape, spacing)
+    if spacing == float("inf"):
+        return shape
+    return working_size(shape, spacing, scan_lines=is_lidar_pattern(sparse_m))
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:

@@ -8,22 +8,27 @@ training saw, and only there:
 
     spacing_px = sqrt(H W / n)                                n samples on an H x W frame
     s          = min(1, TARGET_SPACING_PX / spacing_px,       the working scale (never above the frame's size),
-                     sqrt(MAX_WORKING_PIXELS / (H W)))        and at most MAX_WORKING_PIXELS pixels
+                     sqrt(MAX_WORKING_PIXELS / (H W)))        and, for LiDAR scan lines only, at most
+                                                              MAX_WORKING_PIXELS pixels
     (h, w)     = round(s H), round(s W), the shorter side at least MIN_WORKING_SIDE_PX
 
-Sparse inputs (200 points on 480x640: 39 px apart) run at 0.56x (270x360, capped to 60,000 pixels: 212x283). Dense
-ones (a 64-beam scan, ~5 px apart on a KITTI frame) already lie closer than TARGET_SPACING_PX, but a KITTI-size
-frame still runs below full size (0.38x, 132x455): the prox's receptive field and its training frames (128x160
-crops) cover a fixed number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow
-slice of the street. Measured with lip-any on synthetic test frames (geometric-mean RMSE ratio to linear, native
-size -> rule): 64-beam 352x1216 streets 0.670 -> 0.449, 200 points on 480x640 rooms 0.962 -> 0.846, 50 points
-1.441 -> 0.896; the frame is also 7x cheaper at KITTI size. The data-consistency step and
-the output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every
-measured pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
+Sparse inputs (200 points on 480x640: 39 px apart) run at 0.56x (270x360). Dense scattered ones (1,000 points or
+more on 480x640, 30 % of a KITTI frame's valid pixels) already lie closer than TARGET_SPACING_PX and run at full
+size. A LiDAR scan (64 beams, ~5 px apart on a KITTI frame) also lies closer, but a KITTI-size frame still runs
+below full size (0.48x, 168x580): the prox's receptive field and its training frames (128x160 crops) cover a fixed
+number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow slice of the street
+(the rows between beams, the sky above the top beam). Scattered samples carry no such structure, and capping them
+only throws their detail away. The data-consistency step and the output stay at full resolution
+(`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every measured pixel is set back to its
+measured value (the x-update with rho -> 0 at m = 1).
 
-TARGET_SPACING_PX and MAX_WORKING_PIXELS were chosen on synthetic renders larger than the training frames, by a rule
-fixed before any real frame was scored (benchmarks/working_resolution.py --model lip-any: the (T, P) with the lowest
-geometric-mean RMSE ratio to the linear fill over rooms at 480x640 and streets at 352x1216; T=22 px, P=60,000: 0.732).
+The constants were chosen on synthetic renders larger than the training frames, by a rule fixed before any real
+frame was scored (`python benchmarks/working_resolution.py --model lip-any --frames 6`): T and the cap of scattered
+samples minimise the geometric-mean RMSE ratio to the full-size linear fill over 50 to 5,000 points on 480x640 rooms
+and 200 or 25,000 points on 352x1216 streets (T=22 px, no cap: 0.813; the earlier single cap of 60,000 pixels:
+0.860); the scan-line cap minimises it over 64- and 32-beam scans on those streets (100,000 pixels: 0.697; 60,000:
+0.701; native size: 0.809). Per setting, native size -> rule: 64-beam streets 0.690 -> 0.529, 200 points on rooms
+0.954 -> 0.819, 50 points 1.321 -> 0.813, 25,000 points on streets 0.892 (native; capped at 60,000 pixels 1.051).
 """
 from __future__ import annotations
 
@@ -32,7 +37,7 @@ import math
 import numpy as np
 
 TARGET_SPACING_PX = 22.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
-MAX_WORKING_PIXELS = 60_000  # the largest working size, pixels (see the module doc)
+MAX_WORKING_PIXELS = 100_000  # the largest working size of LiDAR scan lines, pixels (see the module doc)
 MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
 MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
 MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cost more than it brings
@@ -49,14 +54,19 @@ def sample_spacing_px(sparse_m: np.ndarray) -> float:
 
 
 def working_size(shape: tuple[int, int], spacing_px: float, target_spacing_px: float = TARGET_SPACING_PX,
-                 max_pixels: float = MAX_WORKING_PIXELS, min_side_px: int = MIN_WORKING_SIDE_PX) -> tuple[int, int]:
+                 max_pixels: float | None = None, min_side_px: int = MIN_WORKING_SIDE_PX, *,
+                 scan_lines: bool = False) -> tuple[int, int]:
     """(h, w) at which a learned prox runs on a frame of `shape` (H, W) whose samples lie `spacing_px` apart.
 
-    The frame's own size when it is already at most that coarse (s >= MIN_SCALE_CHANGE) or has no samples.
+    `max_pixels` None: MAX_WORKING_PIXELS for LiDAR scan lines (`scan_lines`, lipjax.inputs.is_lidar_pattern),
+    no cap for scattered samples. The frame's own size when it is already at most that coarse
+    (s >= MIN_SCALE_CHANGE) or has no samples.
     """
     big_h, big_w = shape
     if not spacing_px > 0:
         raise ValueError(f"spacing_px must be > 0, got {spacing_px}")
+    if max_pixels is None:
+        max_pixels = MAX_WORKING_PIXELS if scan_lines else math.inf
     s = min(1.0, target_spacing_px / spacing_px, math.sqrt(max_pixels / (big_h * big_w)))
     s = max(s, min(1.0, min_side_px / min(big_h, big_w)))
     if s >= MIN_SCALE_CHANGE:

@@ -7,6 +7,7 @@ import pytest
 
 from lipjax import inference
 from lipjax.classical.interpolate import linear_fill
+from lipjax.inputs import is_lidar_pattern
 from lipjax.methods import get_completer
 from lipjax.resolution import (
     MAX_WORKING_PIXELS,
@@ -42,10 +43,12 @@ def test_working_size_puts_the_samples_at_the_target_spacing():
 
 
 def test_dense_samples_and_small_frames_run_at_full_size():
-    assert working_size((200, 280), 4.7) == (200, 280)  # a dense scan on a frame under the pixel cap
+    assert working_size((200, 280), 4.7, scan_lines=True) == (200, 280)  # a dense scan under the pixel cap
     # a KITTI-size scan: the pixel cap alone sets the scale
-    h, w = working_size((352, 1216), 4.7)
+    h, w = working_size((352, 1216), 4.7, scan_lines=True)
     assert h * w == pytest.approx(MAX_WORKING_PIXELS, rel=0.01) and w / h == pytest.approx(1216 / 352, rel=0.01)
+    # as many scattered samples: no cap, full size
+    assert working_size((352, 1216), 4.7) == (352, 1216)
     s = MIN_SCALE_CHANGE + 0.01
     assert working_size((200, 280), TARGET_SPACING_PX / s) == (200, 280)  # a resize would not pay
     # never below MIN_WORKING_SIDE_PX on the shorter side, however sparse
@@ -86,6 +89,15 @@ def test_frame_size_follows_the_samples_for_learned_models_only():
     h, w = inference.frame_size(model, sparse)
     assert (h, w) == working_size((240, 320), sample_spacing_px(sparse))
     assert (h, w) != (240, 320)
+    # LiDAR scan lines on a frame over the pixel cap: capped; as many scattered samples: full size
+    lines = np.zeros((352, 1216), np.float32)
+    lines[100::5, ::2] = 10.0
+    assert is_lidar_pattern(lines)
+    h, w = inference.frame_size(model, lines)
+    assert h * w <= MAX_WORKING_PIXELS * 1.01 and (h, w) == working_size((352, 1216), sample_spacing_px(lines),
+                                                                            scan_lines=True)
+    scattered = _sparse(352, 1216, int(np.count_nonzero(lines)))
+    assert not is_lidar_pattern(scattered) and inference.frame_size(model, scattered) == (352, 1216)
     assert inference.frame_size(get_completer("linear"), sparse) == (240, 320)
     assert inference.frame_size(model, sparse, max_side=160) == (120, 160)
     with pytest.raises(inference.InputError, match="max_side 3"):
