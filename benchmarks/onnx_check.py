@@ -43,7 +43,7 @@ def _session(path: str):
 
 def _stats_mm(a: np.ndarray, b: np.ndarray) -> str:
     d = np.abs(a.astype(np.float64) - b) * 1e3
-    return f"median {np.median(d):.3f} mm, p99 {np.percentile(d, 99):.2f} mm, max {d.max():.0f} mm"
+    return f"median {np.median(d):.3f} mm, p99 {np.percentile(d, 99):.2f} mm, max {d.max():.1f} mm"
 
 
 def kitti(model: str, root: str, out: str) -> None:

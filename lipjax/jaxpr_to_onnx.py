@@ -124,6 +124,14 @@ def _rsqrt(g: _Graph, eqn, ins):
     return g.node("Reciprocal", [g.node("Sqrt", ins)])
 
 
+def _square(g: _Graph, eqn, ins):
+    return g.node("Mul", [ins[0], ins[0]])
+
+
+def _log1p(g: _Graph, eqn, ins):
+    return g.node("Log", [g.node("Add", [ins[0], np.asarray(1, eqn.invars[0].aval.dtype)])])
+
+
 def _integer_pow(g: _Graph, eqn, ins):
     y = eqn.params["y"]
     if y == 2:
@@ -334,7 +342,7 @@ Handler = Callable[[_Graph, jcore.JaxprEqn, list], object]
 PRIMITIVES: dict[str, Handler] = {
     **{name: _binary for name in _BINARY}, **{name: _unary for name in _UNARY},
     **{name: _logical for name in ("and", "or", "xor", "not")},
-    "ne": _ne, "rsqrt": _rsqrt, "integer_pow": _integer_pow, "round": _round, "is_finite": _is_finite,
+    "ne": _ne, "rsqrt": _rsqrt, "square": _square, "log1p": _log1p, "integer_pow": _integer_pow, "round": _round, "is_finite": _is_finite,
     "convert_element_type": _convert, "select_n": _select_n, "clamp": _clamp,
     "reshape": _reshape, "squeeze": _reshape, "expand_dims": _reshape, "broadcast_in_dim": _broadcast_in_dim,
     "transpose": _transpose, "slice": _slice, "pad": _pad, "concatenate": _concatenate, "stack": _stack,

@@ -137,14 +137,21 @@ class OnnxFile:
         return "\n".join(lines)
 
 
+def need_onnx() -> None:
+    """ImportError naming the install when the onnx package is missing (the export writes with it)."""
+    try:
+        import onnx  # noqa: F401
+    except ImportError:
+        raise ImportError("an ONNX export needs the 'onnx' package: pip install onnx onnxruntime") from None
+
+
 def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
                 samples: int | None = None) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
     `default_samples`) to `out`. ImportError without the onnx package."""
-    try:
-        import onnx
-    except ImportError:
-        raise ImportError("an ONNX export needs the 'onnx' package: pip install onnx onnxruntime") from None
+    need_onnx()
+    import onnx
+
     for name, value in (("batch", batch), ("height", height), ("width", width)):
         if int(value) < 1:
             raise ValueError(f"{name} must be >= 1, got {value}")

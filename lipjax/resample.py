@@ -114,11 +114,13 @@ def reproject_nearest(sparse: jnp.ndarray, size: tuple[int, int]) -> jnp.ndarray
 
 
 def resize_area_uint8(rgb: jnp.ndarray, size: tuple[int, int]) -> jnp.ndarray:
-    """(..., H, W, C) uint8 -> (..., h, w, C) float32 holding cv2.resize(rgb, (w, h), INTER_AREA)'s uint8 values
-    (rounded half to even and saturated, as OpenCV's saturate_cast)."""
+    """(..., H, W, C) uint8 -> (..., h, w, C) float32 holding cv2.resize(rgb, (w, h), INTER_AREA)'s uint8 values:
+    rounded half to even (OpenCV's saturate_cast), or half up for an exact 2x2 shrink (OpenCV's fast path computes
+    (sum + 2) >> 2 there)."""
     big_h, big_w = rgb.shape[-3:-1]
     small = resample_axis(resample_axis(rgb, *area_taps(big_h, size[0]), -3), *area_taps(big_w, size[1]), -2)
-    return jnp.clip(jnp.round(small), 0.0, 255.0)
+    rounded = jnp.floor(small + 0.5) if (big_h, big_w) == (2 * size[0], 2 * size[1]) else jnp.round(small)
+    return jnp.clip(rounded, 0.0, 255.0)
 
 
 def resize_bilinear(a: jnp.ndarray, size: tuple[int, int]) -> jnp.ndarray:
