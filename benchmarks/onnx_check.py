@@ -3,7 +3,7 @@
 Run by hand (never a test; needs onnxruntime):
 
     python benchmarks/onnx_check.py [--model NAME] [--realdata ../shared/realdata] [--out DIR]
-    python benchmarks/onnx_check.py --scattered [--model NAME]
+    python benchmarks/onnx_check.py --scattered [--model NAME] [--frames 5]
 
 Default: the KITTI frames under --realdata (read here, never copied into the repository), cropped to 352x1216 as
 the depth-completion selection (protocol kitti_selection), the HDL-64 pattern drawn on their ground truth as
@@ -12,10 +12,11 @@ exported at 352x1216 (`lipjax export`'s default --samples), run under onnxruntim
 `lipjax.complete(rgb, sparse, model)`.
 Printed per frame: samples, median, 99th percentile and max |ONNX - complete| over all pixels, in mm.
 
---scattered: a synthetic room (lipjax.data renders, test split) at 480x640 with 200 uniform points, where a model
+--scattered: synthetic rooms (lipjax.data renders, test split) at 480x640 with 200 uniform points, where a model
 whose initial fill is "linear" or "auto" runs from the Delaunay fill under lipjax.complete but from the nearest
-fill in the graph. Printed: |ONNX - complete| with the model as shipped and with its nearest twin
-(lipjax.onnx_export.nearest_twin), and each one's RMSE against the rendered depth, metres.
+fill in the graph (default model: the default indoor one, "linear"). Printed per room: the RMSE against the
+rendered depth (metres) of the ONNX graph, of lipjax.complete with the model as shipped and with its nearest twin
+(lipjax.onnx_export.nearest_twin), and |ONNX - each|; then the mean RMSEs.
 """
 from __future__ import annotations
 
@@ -61,24 +62,29 @@ def kitti(model: str, root: str, out: str) -> None:
               f"{_stats_mm(got[0], expected)}")
 
 
-def scattered(model: str, out: str) -> None:
+def scattered(model: str, frames: int, out: str) -> None:
     from lipjax.data.synthetic import render
 
-    sample = render("indoor", "test", 0, 480, 640)
-    sparse = UniformSampler(200)(sample, 0)
     completer = get_completer(model)
     written = export_onnx(completer, os.path.join(out, "room.onnx"), height=480, width=640, samples=200)
     print(written.summary())
-    got, = _session(os.fspath(written.path)).run(None, {"rgb": sample.rgb[None], "sparse": sparse[None]})
-    valid = sample.valid & (sample.depth > 0)
-
-    def rmse(d):
-        return float(np.sqrt(np.mean((d[valid] - sample.depth[valid]) ** 2)))
-
-    print(f"ONNX: RMSE {rmse(got[0]):.4f} m")
-    for label, c in (("as shipped", completer), ("nearest twin", nearest_twin(completer))):
-        expected = complete(sample.rgb, sparse, model=c)
-        print(f"lipjax.complete, {label}: RMSE {rmse(expected):.4f} m; |ONNX - it|: {_stats_mm(got[0], expected)}")
+    session = _session(os.fspath(written.path))
+    methods = (("ONNX", None), ("lipjax.complete as shipped", completer),
+               ("lipjax.complete, nearest twin", nearest_twin(completer)))
+    errors = {label: [] for label, _ in methods}
+    for i in range(frames):
+        sample = render("indoor", "test", i, 480, 640)
+        sparse = UniformSampler(200)(sample, 0)
+        got, = session.run(None, {"rgb": sample.rgb[None], "sparse": sparse[None]})
+        valid = sample.valid & (sample.depth > 0)
+        line = [f"room {i}:"]
+        for label, c in methods:
+            depth = got[0] if c is None else complete(sample.rgb, sparse, model=c)
+            errors[label].append(float(np.sqrt(np.mean((depth[valid] - sample.depth[valid]) ** 2))))
+            line.append(f"{label} RMSE {errors[label][-1]:.4f} m" + ("" if c is None else
+                                                                    f", |ONNX - it| {_stats_mm(got[0], depth)}"))
+        print("; ".join(line))
+    print("mean RMSE over the rooms: " + ", ".join(f"{k} {np.mean(v):.4f} m" for k, v in errors.items()))
 
 
 def main(argv=None) -> None:
@@ -86,12 +92,13 @@ def main(argv=None) -> None:
     ap.add_argument("--model", help="default: the default outdoor model (KITTI), indoor (--scattered)")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
     ap.add_argument("--scattered", action="store_true")
+    ap.add_argument("--frames", type=int, default=5, help="--scattered: rooms of the test split")
     ap.add_argument("--out", help="folder for the .onnx files (default: a temporary one)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or tmp
         if args.scattered:
-            scattered(args.model or DEFAULT_MODELS["indoor"], out)
+            scattered(args.model or DEFAULT_MODELS["indoor"], args.frames, out)
         else:
             kitti(args.model or DEFAULT_MODELS["outdoor"], os.path.abspath(args.realdata), out)
 

@@ -107,12 +107,11 @@ def sample_radius(weights: jax.Array) -> jax.Array:
 JFA_FAR = 2.0**20
 
 
-def _shifted(a: jax.Array, dy: int, dx: int, fill: float) -> jax.Array:
-    """b[..., i, j] = a[..., i + dy, j + dx], `fill` where that falls outside the image."""
+def _neighbours(a: jax.Array, k: int, fill: float) -> jax.Array:
+    """(9, ..., H, W): a[..., i + dy, j + dx] for dy, dx in (-k, 0, k) (row-major), `fill` outside the image."""
     h, w = a.shape[-2:]
-    pad = [(0, 0)] * (a.ndim - 2) + [(max(-dy, 0), max(dy, 0)), (max(-dx, 0), max(dx, 0))]
-    a = jnp.pad(a, pad, constant_values=fill)
-    return a[..., max(dy, 0):max(dy, 0) + h, max(dx, 0):max(dx, 0) + w]
+    a = jnp.pad(a, [(0, 0)] * (a.ndim - 2) + [(k, k), (k, k)], constant_values=fill)
+    return jnp.stack([a[..., k + dy:k + dy + h, k + dx:k + dx + w] for dy in (-k, 0, k) for dx in (-k, 0, k)])
 
 
 def jump_flood_steps(h: int, w: int) -> tuple[int, ...]:
@@ -128,15 +127,15 @@ def jump_flood_steps(h: int, w: int) -> tuple[int, ...]:
 def jump_flood_nearest(sparse: jax.Array) -> jax.Array:
     """(..., H, W) sparse depth in metres, 0 = no sample -> (..., H, W): each pixel the depth of its nearest sample.
 
-    Jump flooding (Rong and Tan 2006): every pixel p holds a seed s(p), the row r, column c and depth of a sample
-    (none at first: r = c = JFA_FAR; its own at a sample). A pass of step k offers p the seeds of p + k (dy, dx),
+    Jump flooding (Rong and Tan 2006): every pixel p holds a seed s(p), the row r and column c of a sample (none at
+    first: r = c = JFA_FAR; its own at a sample). A pass of step k offers p the seeds of p + k (dy, dx),
     dy, dx in {-1, 0, 1}, and p keeps the nearest, d = (r - i)^2 + (c - j)^2 smallest, ties to the smallest key
     c H + r, i.e. the smallest (column, row), as scipy's distance transform breaks them (the host fill). Passes run
     with k = 1, 2^(L-1), ..., 2, 1, 2^L >= max(H, W) (`jump_flood_steps`): L + 1 passes of 9 shifted copies and
-    a min over them, no gather and no data-dependent loop. JFA is exact unless a pixel's nearest seed reaches it
-    only through pixels that keep other seeds: rare, and the seed it keeps is then only slightly farther
-    (tests/test_fill.py measures both against the exact fill). Images without any sample give 0.
-    Exact in float32 (squared distances and keys) for H W < 2^24 and max(H, W) < 2900.
+    a min over them, no data-dependent loop; then one gather reads each pixel's seed depth. JFA is exact unless a
+    pixel's nearest seed reaches it only through pixels that keep other seeds: rare, and the seed it keeps is then
+    only slightly farther (tests/test_fill.py measures it against the exact fill). Images without any sample give 0.
+    Exact in float32 (squared distances, keys, flat indices) for B H W < 2^24 and max(H, W) < 2900.
     """
     h, w = sparse.shape[-2:]
     sparse = sparse.astype(jnp.float32)
@@ -144,17 +143,15 @@ def jump_flood_nearest(sparse: jax.Array) -> jax.Array:
     j = jnp.arange(w, dtype=jnp.float32)[None, :]
     has = sparse > 0
     seed_r, seed_c = jnp.where(has, i, JFA_FAR), jnp.where(has, j, JFA_FAR)
-    value = jnp.where(has, sparse, 0.0)
     for k in jump_flood_steps(h, w):
-        offsets = [(dy, dx) for dy in (-k, 0, k) for dx in (-k, 0, k)]
-        r = jnp.stack([_shifted(seed_r, dy, dx, JFA_FAR) for dy, dx in offsets])  # (9, ..., H, W)
-        c = jnp.stack([_shifted(seed_c, dy, dx, JFA_FAR) for dy, dx in offsets])
-        v = jnp.stack([_shifted(value, dy, dx, 0.0) for dy, dx in offsets])
+        r, c = _neighbours(seed_r, k, JFA_FAR), _neighbours(seed_c, k, JFA_FAR)  # (9, ..., H, W)
         d = (r - i) ** 2 + (c - j) ** 2
-        nearest = d == d.min(axis=0)
-        key = jnp.where(nearest, c * h + r, jnp.inf).min(axis=0)  # one seed: the smallest (column, row)
+        candidate_key = c * h + r
+        key = jnp.where(d == d.min(axis=0), candidate_key, jnp.inf).min(axis=0)  # the smallest (column, row)
         found = key < h * w  # a real key is below H W, a seedless one (JFA_FAR)(H + 1) above
         seed_c = jnp.where(found, jnp.floor(key / h), JFA_FAR)
         seed_r = jnp.where(found, key - seed_c * h, JFA_FAR)
-        value = jnp.where(nearest & (c * h + r == key), v, 0.0).max(axis=0)
-    return value
+    # Each pixel's seed read from the image once: flat index over all images, (image, row, column).
+    images = np.arange(int(np.prod(sparse.shape[:-2])), dtype=np.float32).reshape(sparse.shape[:-2] + (1, 1))
+    flat = jnp.where(found, images * (h * w) + seed_r * w + seed_c, 0.0).astype(jnp.int32)
+    return jnp.where(found, jnp.take(sparse.reshape(-1), flat), 0.0)

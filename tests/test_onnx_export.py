@@ -79,7 +79,8 @@ def auto_model():
     leaves, treedef = jax.tree_util.tree_flatten(c.params)
     rng = np.random.default_rng(0)
     leaves = [np.asarray(a) + 0.05 * rng.standard_normal(np.shape(a)).astype(np.float32) for a in leaves]
-    return lipjax.Completer(config, jax.tree_util.tree_unflatten(treedef, leaves), "tiny-auto")
+    return lipjax.Completer(config, jax.tree_util.tree_unflatten(treedef, leaves), "tiny-auto",
+                            {"train_sampler": "uniform:10|lidar:hdl64"})  # no input warning for either pattern
 
 
 def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path):
