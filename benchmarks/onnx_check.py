@@ -77,13 +77,13 @@ def scattered(model: str, frames: int, out: str) -> None:
         sparse = UniformSampler(200)(sample, 0)
         got, = session.run(None, {"rgb": sample.rgb[None], "sparse": sparse[None]})
         valid = sample.valid & (sample.depth > 0)
-        line = [f"room {i}:"]
+        line = []
         for label, c in methods:
             depth = got[0] if c is None else complete(sample.rgb, sparse, model=c)
             errors[label].append(float(np.sqrt(np.mean((depth[valid] - sample.depth[valid]) ** 2))))
             line.append(f"{label} RMSE {errors[label][-1]:.4f} m" + ("" if c is None else
                                                                     f", |ONNX - it| {_stats_mm(got[0], depth)}"))
-        print("; ".join(line))
+        print(f"room {i}: " + "; ".join(line))
     print("mean RMSE over the rooms: " + ", ".join(f"{k} {np.mean(v):.4f} m" for k, v in errors.items()))
 
 

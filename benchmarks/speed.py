@@ -11,7 +11,8 @@ through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its wor
 host fill, solver and resizes included. "default" is the model `lipjax complete` picks for the frame.
 "onnx:NAME" (NAME a model or "default") is that model exported for the frame's size and sample count
 (lipjax.onnx_export: one graph, fill and resizes inside) and run under onnxruntime on the CPU with its default
-threads; the export and the session's start are not timed.
+threads, spin-waiting off (on the 2-core machine shared with a training run, the spinning threads doubled its
+time: 160 against 80 ms on the street); the export and the session's start are not timed.
 
 Columns per size: ms per frame (median of --repeats calls after a warm-up) and frames/s normalised to a 195 GFLOP/s
 machine: fps * 195 / (this run's 2048^3 float32 matmul rate). The rate and the 1-minute load average are printed
@@ -77,11 +78,13 @@ def _runner(name: str, rgb: np.ndarray, sparse: np.ndarray):
         return (lambda: complete_frame(completer, rgb, sparse)), label
     import onnxruntime as ort
 
-    path = os.path.join(tempfile.mkdtemp(), "model.onnx")
+    path = os.path.join(tempfile.mkdtemp(prefix="lipjax-speed-"), "model.onnx")
     written = export_onnx(completer, path, height=sparse.shape[0], width=sparse.shape[1],
                           samples=int((sparse > 0).sum()))
     assert written.working == (h, w), (written.working, (h, w))
-    session = ort.InferenceSession(path, providers=["CPUExecutionProvider"])
+    options = ort.SessionOptions()
+    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    session = ort.InferenceSession(path, options, providers=["CPUExecutionProvider"])
     feeds = {"rgb": rgb[None], "sparse": sparse[None].astype(np.float32)}
     return (lambda: session.run(None, feeds)), label
 
