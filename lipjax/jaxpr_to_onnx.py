@@ -342,7 +342,8 @@ Handler = Callable[[_Graph, jcore.JaxprEqn, list], object]
 PRIMITIVES: dict[str, Handler] = {
     **{name: _binary for name in _BINARY}, **{name: _unary for name in _UNARY},
     **{name: _logical for name in ("and", "or", "xor", "not")},
-    "ne": _ne, "rsqrt": _rsqrt, "square": _square, "log1p": _log1p, "integer_pow": _integer_pow, "round": _round, "is_finite": _is_finite,
+    "ne": _ne, "rsqrt": _rsqrt, "square": _square, "log1p": _log1p, "integer_pow": _integer_pow, "round": _round,
+    "is_finite": _is_finite,
     "convert_element_type": _convert, "select_n": _select_n, "clamp": _clamp,
     "reshape": _reshape, "squeeze": _reshape, "expand_dims": _reshape, "broadcast_in_dim": _broadcast_in_dim,
     "transpose": _transpose, "slice": _slice, "pad": _pad, "concatenate": _concatenate, "stack": _stack,

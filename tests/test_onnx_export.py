@@ -26,7 +26,8 @@ def _kitchen_sink(x, u8, idx):
     """Most primitives lipjax.jaxpr_to_onnx translates, on (2, 12, 10, 3) float32, uint8 and int32 inputs."""
     y = jnp.tanh(x) * jax.nn.sigmoid(x) - jnp.abs(x) / (1.0 + x**2) + jnp.floor(3 * x) + jnp.round(4.5 * x)
     y = jnp.where(jnp.isfinite(1.0 / x) & (x > 0.1), jnp.sqrt(jnp.abs(x)), jax.lax.rsqrt(1.0 + x**4)) + y
-    y = jnp.clip(y, -2.0, 2.0) + jnp.cumsum(x, axis=1) + jnp.square(x) - jnp.log1p(x**2) + jnp.maximum(x, 0.3) + jnp.minimum(x, -0.2)
+    y = jnp.clip(y, -2.0, 2.0) + jnp.cumsum(x, axis=1) + jnp.square(x) - jnp.log1p(x**2)
+    y = y + jnp.maximum(x, 0.3) + jnp.minimum(x, -0.2)
     kernel = jnp.asarray(np.random.default_rng(0).standard_normal((3, 3, 3, 4)), jnp.float32)
     conv = jax.lax.conv_general_dilated(y, kernel, (2, 1), "SAME", rhs_dilation=(1, 2),
                                         dimension_numbers=("NHWC", "HWIO", "NHWC"))
