@@ -2,13 +2,17 @@
 
 Run by hand (never a test):
 
-    python benchmarks/speed.py [--models default,lip-fast-indoor] [--classical linear,nearest,ip_basic,colorization]
-                               [--repeats 5] [--frames synthetic]
+    python benchmarks/speed.py [--models default,onnx:default,lip-fast-indoor]
+                               [--classical linear,nearest,ip_basic,colorization] [--repeats 5]
 
 Frames: synthetic test renders (the test split, never trained on) at 256x320 and 480x640 with 200 uniform points
 (a room) and at 352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
 through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its working size (lipjax.resolution),
 host fill, solver and resizes included. "default" is the model `lipjax complete` picks for the frame.
+"onnx:NAME" (NAME a model or "default") is that model exported for the frame's size and sample count
+(lipjax.onnx_export: one graph, fill and resizes inside) and run under onnxruntime on the CPU with its default
+threads, spin-waiting off (on the 2-core machine shared with a training run, the spinning threads doubled its
+time: 160 against 80 ms on the street); the export and the session's start are not timed.
 
 Columns per size: ms per frame (median of --repeats calls after a warm-up) and frames/s normalised to a 195 GFLOP/s
 machine: fps * 195 / (this run's 2048^3 float32 matmul rate). The rate and the 1-minute load average are printed
@@ -19,6 +23,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import tempfile
 
 import numpy as np
 
@@ -28,6 +33,7 @@ from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import render  # noqa: E402
 from lipjax.inference import complete_frame, frame_size  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
+from lipjax.onnx_export import export_onnx  # noqa: E402
 
 REFERENCE_GFLOPS = 195.0  # the rate the issues normalise frames/s to
 SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
@@ -37,7 +43,7 @@ SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--models", default="default,lip-fast-indoor")
+    ap.add_argument("--models", default="default,onnx:default,lip-fast-indoor")
     ap.add_argument("--classical", default="linear,nearest,ip_basic,colorization")
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args(argv)
@@ -55,12 +61,32 @@ def main(argv=None) -> None:
     for name in names:
         cells = []
         for _, rgb, sparse in frames:
-            completer = get_completer(None if name == "default" else name, sparse=sparse)
-            ms = _median_ms(lambda: complete_frame(completer, rgb, sparse), args.repeats)
-            h, w = frame_size(completer, sparse)
-            label = f" [{completer.name} at {h}x{w}]" if name == "default" else ""
+            run, label = _runner(name, rgb, sparse)
+            ms = _median_ms(run, args.repeats)
             cells.append(f"{ms:.0f} ({1e3 / ms * REFERENCE_GFLOPS / rate:.1f}){label}")
         print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+
+
+def _runner(name: str, rgb: np.ndarray, sparse: np.ndarray):
+    """(a call that completes the frame, the cell's label) for a method name of --models / --classical."""
+    onnx = name.startswith("onnx:")
+    model = name.removeprefix("onnx:")
+    completer = get_completer(None if model == "default" else model, sparse=sparse)
+    h, w = frame_size(completer, sparse)
+    label = f" [{completer.name} at {h}x{w}]" if model == "default" else ""
+    if not onnx:
+        return (lambda: complete_frame(completer, rgb, sparse)), label
+    import onnxruntime as ort
+
+    path = os.path.join(tempfile.mkdtemp(prefix="lipjax-speed-"), "model.onnx")
+    written = export_onnx(completer, path, height=sparse.shape[0], width=sparse.shape[1],
+                          samples=int((sparse > 0).sum()))
+    assert written.working == (h, w), (written.working, (h, w))
+    options = ort.SessionOptions()
+    options.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    session = ort.InferenceSession(path, options, providers=["CPUExecutionProvider"])
+    feeds = {"rgb": rgb[None], "sparse": sparse[None].astype(np.float32)}
+    return (lambda: session.run(None, feeds)), label
 
 
 if __name__ == "__main__":

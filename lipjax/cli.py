@@ -9,7 +9,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model NAME|PATH] --height H --width W [--batch B] --out FILE.stablehlo   (format from the name)
+    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] --out FILE.onnx|.stablehlo
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models
@@ -92,8 +92,8 @@ def _cmd_export(args) -> int:
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     try:
         written = export(args.model, args.out, height=args.height, width=args.width, batch=args.batch,
-                         iterations=args.iterations, platforms=platforms)
-    except ImportError as exc:  # the optional flatbuffers package
+                         iterations=args.iterations, platforms=platforms, samples=args.samples)
+    except ImportError as exc:  # the optional flatbuffers / onnx packages
         raise console.UserError(str(exc)) from exc
     if not args.quiet:
         _say(written.summary())
@@ -220,14 +220,14 @@ def _add_evaluate_parser(sub) -> None:
 
 
 def _add_export_parser(sub) -> None:
-    x = sub.add_parser("export", help="export a model as StableHLO (jax.export) for a fixed input shape")
+    x = sub.add_parser("export", help="export a model as ONNX (onnxruntime) or StableHLO (jax) for one input shape")
     _add_model_args(x)
     x.add_argument("--height", type=console.positive_int, required=True)
     x.add_argument("--width", type=console.positive_int, required=True)
     x.add_argument("--batch", type=console.positive_int, default=1)
-    x.add_argument("--platforms", help="comma-separated, e.g. cpu,cuda (default: this machine's)")
-    x.add_argument("--out", required=True, metavar="FILE.stablehlo",
-                   help="the extension chooses the format: .stablehlo (serialised StableHLO, which JAX runs)")
+    x.add_argument("--samples", type=console.positive_int, help=".onnx: samples per frame (sets the working size)")
+    x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
+    x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
     x.add_argument("--quiet", action="store_true")
     x.set_defaults(func=_cmd_export)
 

@@ -1,4 +1,5 @@
-"""Exports a trained model's inference function as serialised StableHLO (`jax.export`), for a fixed input shape.
+"""Exports a trained model for a fixed input shape: as serialised StableHLO (`jax.export`, here), or as one ONNX
+graph with the initial fill and the resizes inside (lipjax.onnx_export, for onnxruntime: the deployment format).
 
     exported = export_completer(lipjax.load_model("lip-ad-indoor"), batch=1, height=480, width=640)
     save_exported(exported, "lip-ad-indoor_1x480x640.stablehlo")
@@ -6,8 +7,9 @@
     depth = run(rgb_uint8_bhw3, sparse_f32_bhw)                        # (B, H, W) float32 metres
 
 or from the shell: `lipjax export --model lip-ad-indoor --height 480 --width 640 --out model.stablehlo`, which runs
-`export(model, out, height=..., width=...)`: the extension of `out` chooses the format (EXPORT_FORMATS; .stablehlo
-only so far, anything else is an error before the model loads).
+`export(model, out, height=..., width=...)`: the extension of `out` chooses the format (EXPORT_FORMATS: .stablehlo
+or .onnx; anything else is an error before the model loads). The choices below are the StableHLO export's; the
+ONNX export's are in lipjax.onnx_export.
 
 Choices:
   - The parameters are baked into the program as constants, so the file is the whole model: nothing else to
@@ -45,8 +47,10 @@ import numpy as np
 
 from lipjax.inference import Completer
 from lipjax.methods import get_completer
+from lipjax.onnx_export import OnnxFile, export_onnx, need_onnx
 
-EXPORT_FORMATS = {".stablehlo": "serialised StableHLO for jax.export, which JAX runs"}
+EXPORT_FORMATS = {".stablehlo": "serialised StableHLO for jax.export, which JAX runs",
+                  ".onnx": "one ONNX graph, initial fill and resizes inside, which onnxruntime runs"}
 """The formats `export` writes, by the extension of its output file."""
 
 
@@ -141,7 +145,7 @@ def export_format(path: str | os.PathLike) -> str:
     if suffix not in EXPORT_FORMATS:
         known = ", ".join(f"{ext} ({what})" for ext, what in EXPORT_FORMATS.items())
         raise ValueError(f"--out {os.fspath(path)}: unknown export format {suffix or '(no extension)'!r}; give it "
-                         f"one of these extensions: {known}; ONNX (.onnx) is not supported yet")
+                         f"one of these extensions: {known}")
     return suffix
 
 
@@ -164,18 +168,25 @@ class ExportedFile:
 
 
 def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
-           platforms: Sequence[str] | None = None) -> ExportedFile:
+           platforms: Sequence[str] | None = None, samples: int | None = None) -> ExportedFile | OnnxFile:
     """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
-    (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`).
+    (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`). `platforms`
+    applies to .stablehlo, `samples` (per frame, which sets the working size) to .onnx.
 
-    Raises ValueError for an unknown extension or a hand-crafted fill (nothing learned to export), ImportError
-    without the flatbuffers package; all before the model loads."""
-    export_format(out)
-    _need_flatbuffers()
+    Raises ValueError for an unknown extension, an option of the other format or a hand-crafted fill (nothing
+    learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the
+    model loads."""
+    onnx = export_format(out) == ".onnx"
+    wrong = ("--platforms", platforms, ".stablehlo") if onnx else ("--samples", samples, ".onnx")
+    if wrong[1] is not None:
+        raise ValueError(f"{wrong[0]} applies to {wrong[2]} exports only; drop it for {os.fspath(out)}")
+    need_onnx() if onnx else _need_flatbuffers()
     completer = get_completer(model, iterations)
     if not isinstance(completer, Completer):
         raise ValueError(f"--model {completer.name}: a hand-crafted fill has no learned model to export; export a "
                          "shipped model (lipjax models) or a saved model path")
+    if onnx:
+        return export_onnx(completer, out, height=height, width=width, batch=batch, samples=samples)
     exported = export_completer(completer, batch, height, width, platforms=platforms)
     path = save_exported(exported, out)
     return ExportedFile(path, exported, completer.config.initial_estimate if len(exported.in_avals) == 3 else None)

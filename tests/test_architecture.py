@@ -25,7 +25,7 @@ LAYERS = {
     # 0: the maths and the leaves (no lipjax imports but within this layer)
     "lipjax.operators": 0, "lipjax.admm": 0, "lipjax.fill": 0, "lipjax.priors": 0, "lipjax.interfaces": 0,
     "lipjax.metrics": 0, "lipjax.zbuffer": 0, "lipjax.viz": 0, "lipjax.shipped": 0, "lipjax.utils": 0,
-    "lipjax.resolution": 0,
+    "lipjax.resolution": 0, "lipjax.resample": 0, "lipjax.jaxpr_to_onnx": 0,
     "lipjax.console": 0,
     # 1: frames: data sets, samplers, the synthetic renderer, input checks, hand-crafted completers
     "lipjax.data": 1, "lipjax.pointcloud": 1, "lipjax.inputs": 1, "lipjax.classical": 1,
@@ -33,7 +33,7 @@ LAYERS = {
     "lipjax.model": 2, "lipjax.networks": 2, "lipjax.model_io": 2,
     # 3: running them: inference, the resolver, evaluation, training, export, files and folders on disk
     "lipjax.inference": 3, "lipjax.export": 3, "lipjax.uncertainty": 3, "lipjax.methods": 3, "lipjax.evaluate": 3,
-    "lipjax.train": 3, "lipjax.files": 3,
+    "lipjax.train": 3, "lipjax.files": 3, "lipjax.onnx_export": 3,
     # 4: the front doors
     "lipjax.cli": 4, "lipjax": 4,
 }

@@ -426,3 +426,16 @@ def test_export_command_writes_a_deserializable_file(model, tmp_path):
     exported = jax.export.deserialize(bytearray(out.read_bytes()))
     assert [a.shape for a in exported.in_avals] == [(2, 8, 16, 3), (2, 8, 16)]
     assert exported.out_avals[0].shape == (2, 8, 16)
+
+
+def test_export_command_writes_an_onnx_graph_with_the_fill_inside(model, tmp_path, capsys):
+    ort = pytest.importorskip("onnxruntime")
+    out = tmp_path / "m.onnx"
+    rc = cli.main(["export", "--model", model[0], "--height", str(H), "--width", str(W), "--out", str(out)])
+    assert rc == 0 and f"wrote {out}" in capsys.readouterr().err
+    rgb, sparse = _frame()
+    got, = ort.InferenceSession(str(out), providers=["CPUExecutionProvider"]).run(
+        None, {"rgb": rgb[None], "sparse": sparse[None].astype(np.float32)})
+    np.testing.assert_allclose(got[0], lipjax.complete(rgb, sparse, model=model[1]), rtol=1e-5, atol=1e-4)
+    rc = cli.main(["export", "--height", "8", "--width", "8", "--platforms", "cpu", "--out", str(out)])
+    assert rc == 1 and "--platforms applies to .stablehlo exports only" in capsys.readouterr().err

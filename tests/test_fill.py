@@ -1,9 +1,12 @@
-"""The box fill used as ADMM's z_0: exact at samples, exact on constants, nearest-ish elsewhere."""
+"""The box fill used as ADMM's z_0: exact at samples, exact on constants, nearest-ish elsewhere; the jump-flooding
+nearest fill against the exact host fill."""
+import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from lipjax.fill import box_fill, box_fill_with_radius, sample_radius
+from lipjax.classical.nearest import nearest_fill
+from lipjax.fill import box_fill, box_fill_with_radius, jump_flood_nearest, jump_flood_steps, sample_radius
 
 
 def test_samples_are_kept_and_radius_measures_distance_to_a_sample():
@@ -50,3 +53,50 @@ def test_sample_radius_without_samples_is_zero_like_the_box_fills():
     mask = jnp.zeros((2, 9, 13), jnp.float32)
     np.testing.assert_array_equal(sample_radius(mask), box_fill_with_radius(mask, mask)[1])
     assert not np.asarray(sample_radius(mask)).any()
+
+
+def _patterns(shape, seed=0):
+    """(N, H, W) sparse maps: scattered points at three densities and LiDAR-like scan lines, depths 1-80 m."""
+    rng = np.random.default_rng(seed)
+    n, h, w = shape
+    out = np.zeros(shape, np.float32)
+    for k in range(n):
+        if k % 2:  # scan lines: every 1-3 rows, 60 % of the pixels of a line
+            rows = np.arange(rng.integers(0, 3), h, rng.integers(1, 4))
+            mask = np.zeros((h, w), bool)
+            mask[rows] = rng.random((rows.size, w)) < 0.6
+        else:
+            mask = rng.random((h, w)) < (0.003, 0.02, 0.1)[(k // 2) % 3]
+            mask[rng.integers(h), rng.integers(w)] = True
+        out[k] = np.where(mask, rng.uniform(1, 80, (h, w)), 0)
+    return out
+
+
+def test_jump_flood_equals_the_exact_nearest_fill_on_scan_lines_and_almost_on_points():
+    """The host fill is exact (scipy's distance transform) and breaks ties by the smallest (column, row); the
+    jump flood breaks them the same way and misses only where its propagation does: measured 2 pixels in 1.2
+    million on 132x455 scattered points, none on scan lines. Here: no miss on scan lines, < 0.1 % on points."""
+    sparse = _patterns((12, 48, 72))
+    got = np.asarray(jax.jit(jump_flood_nearest)(sparse))
+    expected = np.stack([nearest_fill(s) for s in sparse])
+    lines, points = slice(1, None, 2), slice(0, None, 2)
+    np.testing.assert_array_equal(got[lines], expected[lines])
+    assert np.mean(got[points] != expected[points]) < 1e-3
+
+
+def test_jump_flood_closed_forms_one_sample_ties_and_no_sample():
+    y = np.zeros((3, 9, 12), np.float32)
+    y[0, 4, 7] = 2.5  # one sample: its depth everywhere
+    y[1, 2, 3], y[1, 2, 9] = 1.0, 3.0  # columns 3 and 9: column 6 is equidistant and takes column 3 (smaller)
+    y[1, 6, 6] = 0.0
+    got = np.asarray(jump_flood_nearest(y))
+    np.testing.assert_array_equal(got[0], 2.5)
+    np.testing.assert_array_equal(got[1][:, :6], 1.0)
+    np.testing.assert_array_equal(got[1][:, 7:], 3.0)
+    np.testing.assert_array_equal(got[1][:, 6], 1.0)
+    np.testing.assert_array_equal(got[2], 0.0)  # no sample: zeros
+
+
+def test_jump_flood_steps_reach_every_pixel():
+    assert jump_flood_steps(1, 1) == (1,)
+    assert jump_flood_steps(132, 455) == (1, 256, 128, 64, 32, 16, 8, 4, 2, 1)

@@ -1,0 +1,179 @@
+"""Exports a learned model as ONE self-contained ONNX graph: frame in, dense depth out, everything in between inside.
+
+    written = export_onnx(lipjax.load_model("lip-ad-fast-outdoor"), "kitti.onnx", height=352, width=1216)
+    # or: lipjax export --model lip-ad-fast-outdoor --height 352 --width 1216 --out kitti.onnx
+
+    import onnxruntime as ort
+    depth, = ort.InferenceSession("kitti.onnx").run(None, {"rgb": rgb_u8_bhw3, "sparse": sparse_m_bhw})
+
+Signature: inputs `rgb` uint8 (B, H, W, 3) and `sparse` float32 (B, H, W) metres, 0 = no sample; output `depth`
+float32 (B, H, W) metres. B, H and W are fixed at export (`--batch`, `--height`, `--width`); another size needs
+another export (the resize tables below are constants of the graph).
+
+The graph is `inference_graph`, the default path of `lipjax.complete` (lipjax.inference.complete_at) written in
+jax.numpy, converted by lipjax.jaxpr_to_onnx (a translator of our own: jax2onnx pins an orbax-checkpoint older
+than the one lipjax trains with, see that module):
+
+  1. the working size (h, w) is fixed at export: lipjax.resolution.working_size of (H, W) for `samples` samples
+     per frame (`export_working_size`). `lipjax.complete` picks it per frame from the frame's own sample count n;
+     it is the same (h, w) for every n in an interval (`samples_interval`), printed and stored in the metadata.
+     At 352x1216 and 480x640 that interval is every n from 125 up: the pixel cap MAX_WORKING_PIXELS decides.
+  2. rgb -> (h, w) as cv2.resize(INTER_AREA) and its uint8 rounding; sparse -> (h, w) by reprojection, the
+     nearest depth winning (lipjax.resample: gathers with constant tables, mins and sums).
+  3. z0, the initial fill, in the graph: the nearest-sample fill by jump flooding (lipjax.fill.jump_flood_nearest),
+     which equals the host fill `host_initial_estimate("nearest", ...)` (ties broken as scipy breaks them)
+     except at a few pixels in a million (tests/test_fill.py). The host's "linear" (Delaunay) fill has no
+     fixed-size program, so a model whose initial_estimate is "linear" or "auto" runs from the nearest fill in
+     the graph: the same as its JAX result with the nearest fill, get that with
+     `lipjax.complete(rgb, sparse, model=nearest_twin(model))`. "auto" picks nearest for LiDAR scan lines, so
+     for scan lines such a model's export equals lipjax.complete; for scattered points it differs from its
+     linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m in the
+     graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room
+     (benchmarks/onnx_check.py --scattered). The shipped outdoor models use "nearest": their export equals
+     lipjax.complete on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm, 99th percentile
+     at most 0.71 mm; benchmarks/onnx_check.py).
+  4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
+     (cv2's INTER_LINEAR) and the measured pixels set back to their measured values.
+At h, w = H, W the resizes and the restoring drop out, as in complete_at. No input checks run inside the graph
+(check with `lipjax.inputs.check_inputs` where lipjax is installed); a frame without samples gives zeros.
+Speed (benchmarks/speed.py, 2-core machine): a KITTI frame took 69 ms under onnxruntime against 34 ms for the same
+computation in XLA, which fuses the element-wise operations that onnxruntime runs one pass each.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import os
+import pathlib
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from lipjax import jaxpr_to_onnx
+from lipjax.fill import jump_flood_nearest
+from lipjax.inference import Completer
+from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
+from lipjax.resolution import working_size
+
+INPUT_NAMES, OUTPUT_NAMES = ("rgb", "sparse"), ("depth",)
+DEFAULT_SPACING_PX = 4.6  # a 64-beam scan on a KITTI frame (~20,000 samples on 352x1216): the robot / car case
+
+
+def default_samples(height: int, width: int) -> int:
+    """The sample count `export_onnx` plans for unless told: a 64-beam LiDAR's density, DEFAULT_SPACING_PX apart."""
+    return max(1, round(height * width / DEFAULT_SPACING_PX**2))
+
+
+def export_working_size(height: int, width: int, samples: int) -> tuple[int, int]:
+    """(h, w) at which lipjax.complete runs a learned model on an (height, width) frame of `samples` samples."""
+    if not 1 <= samples <= height * width:
+        raise ValueError(f"--samples {samples}: give the number of depth samples per frame, 1 to {height * width}")
+    return working_size((height, width), math.sqrt(height * width / samples))
+
+
+def samples_interval(height: int, width: int, samples: int) -> tuple[int, int]:
+    """(lo, hi): the sample counts n for which lipjax.complete picks the same working size as for `samples`. The
+    size never shrinks as n grows, so they are an interval, found by bisection."""
+    size, n_max = export_working_size(height, width, samples), height * width
+
+    def first(lo: int, hi: int, is_past) -> int:  # the smallest n in [lo, hi] with is_past(n); is_past(hi) holds
+        while lo < hi:
+            mid = (lo + hi) // 2
+            lo, hi = (lo, mid) if is_past(mid) else (mid + 1, hi)
+        return lo
+
+    low = first(1, samples, lambda n: export_working_size(height, width, n) == size)
+    high = first(samples, n_max + 1, lambda n: n > n_max or export_working_size(height, width, n) != size) - 1
+    return low, high
+
+
+def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int]):
+    """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
+    graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX."""
+    config = completer.config
+    params = jax.tree_util.tree_map(jnp.asarray, completer.params)
+    unknown = set(config.host_input_names) - {"z0"}
+    if unknown:
+        raise ValueError(f"{completer.name} needs host inputs {sorted(unknown)} that have no in-graph version")
+    resized = tuple(working) != tuple(frame)
+
+    def run(rgb, sparse):
+        small_rgb, small = (resize_area_uint8(rgb, working) / 255.0, reproject_nearest(sparse, working)) if resized \
+            else (rgb, sparse)
+        extra = {name: jump_flood_nearest(small) for name in config.host_input_names}
+        depth = jnp.maximum(config.apply(params, small_rgb, small, **extra)[0], 0.0)
+        return jnp.where(sparse > 0, sparse, resize_bilinear(depth, frame)) if resized else depth
+
+    return run
+
+
+def nearest_twin(completer: Completer) -> Completer:
+    """The model with the initial fill its ONNX export computes: "nearest" where it is computed on the host."""
+    config = completer.config
+    if getattr(config, "initial_estimate", None) not in ("linear", "auto"):
+        return completer
+    return Completer(dataclasses.replace(config, initial_estimate="nearest"), completer.params, completer.name,
+                     completer.metadata)
+
+
+@dataclasses.dataclass(frozen=True)
+class OnnxFile:
+    """What `export_onnx` wrote: the file, the input shape (B, H, W), the working size, the sample counts for which
+    that is lipjax.complete's working size, and the model's own initial fill when the graph's nearest fill replaced
+    it (else None)."""
+
+    path: pathlib.Path
+    shape: tuple[int, int, int]
+    working: tuple[int, int]
+    samples: tuple[int, int]
+    replaced_fill: str | None
+
+    def summary(self) -> str:
+        """The lines the export command prints: file and signature, the working size, the fill."""
+        b, h, w = self.shape
+        lines = [f"wrote {self.path} ({self.path.stat().st_size} bytes): rgb uint8 {(b, h, w, 3)}, sparse float32 "
+                 f"{(b, h, w)} m -> depth float32 {(b, h, w)} m (ONNX opset {jaxpr_to_onnx.OPSET}, fixed shape)",
+                 f"working size {self.working[0]}x{self.working[1]}: lipjax.complete's for {self.samples[0]} to "
+                 f"{self.samples[1]} samples per frame (--samples sets it)"]
+        if self.replaced_fill:
+            lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
+                         "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
+        return "\n".join(lines)
+
+
+def need_onnx() -> None:
+    """ImportError naming the install when the onnx package is missing (the export writes with it)."""
+    try:
+        import onnx  # noqa: F401
+    except ImportError:
+        raise ImportError("an ONNX export needs the 'onnx' package: pip install onnx onnxruntime") from None
+
+
+def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
+                samples: int | None = None) -> OnnxFile:
+    """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
+    `default_samples`) to `out`. ImportError without the onnx package."""
+    need_onnx()
+    import onnx
+
+    for name, value in (("batch", batch), ("height", height), ("width", width)):
+        if int(value) < 1:
+            raise ValueError(f"{name} must be >= 1, got {value}")
+    samples = default_samples(height, width) if samples is None else samples
+    working = export_working_size(height, width, samples)
+    interval = samples_interval(height, width, samples)
+    fill = getattr(completer.config, "initial_estimate", None)
+    replaced = fill if fill in ("linear", "auto") else None
+    metadata = {"lipjax_model": completer.name, "units": "metres; sparse 0 = no sample",
+                "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
+                "working_size_samples": f"{interval[0]}-{interval[1]}",
+                "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else "")}
+    specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
+             jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
+    model = jaxpr_to_onnx.convert(inference_graph(completer, (height, width), working), specs, INPUT_NAMES,
+                                  OUTPUT_NAMES, metadata, doc=__doc__.split("\n")[0])
+    path = pathlib.Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    onnx.save(model, os.fspath(path))
+    return OnnxFile(path, (batch, height, width), working, interval, replaced)
