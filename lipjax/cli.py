@@ -9,11 +9,10 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] --out FILE.onnx|.stablehlo
+    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N [--scattered]] --out FILE.onnx
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
-    lipjax models
-    lipjax --version
+    lipjax models | lipjax --version
 
 Run `lipjax COMMAND --help` for a command's options.
 """
@@ -91,8 +90,8 @@ def _cmd_evaluate(args) -> int:
 def _cmd_export(args) -> int:
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     try:
-        written = export(args.model, args.out, height=args.height, width=args.width, batch=args.batch,
-                         iterations=args.iterations, platforms=platforms, samples=args.samples)
+        written = export(args.model, args.out, iterations=args.iterations, platforms=platforms,
+                         **{k: getattr(args, k) for k in ("height", "width", "batch", "samples", "scattered")})
     except ImportError as exc:  # the optional flatbuffers / onnx packages
         raise console.UserError(str(exc)) from exc
     if not args.quiet:
@@ -226,6 +225,7 @@ def _add_export_parser(sub) -> None:
     x.add_argument("--width", type=console.positive_int, required=True)
     x.add_argument("--batch", type=console.positive_int, default=1)
     x.add_argument("--samples", type=console.positive_int, help=".onnx: samples per frame (sets the working size)")
+    x.add_argument("--scattered", action="store_true", help=".onnx: scattered points, not LiDAR scan lines")
     x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
     x.add_argument("--quiet", action="store_true")

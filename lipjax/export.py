@@ -168,16 +168,19 @@ class ExportedFile:
 
 
 def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
-           platforms: Sequence[str] | None = None, samples: int | None = None) -> ExportedFile | OnnxFile:
+           platforms: Sequence[str] | None = None, samples: int | None = None,
+           scattered: bool = False) -> ExportedFile | OnnxFile:
     """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
     (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`). `platforms`
-    applies to .stablehlo, `samples` (per frame, which sets the working size) to .onnx.
+    applies to .stablehlo, `samples` (per frame) and `scattered` (points, not LiDAR scan lines), which set the
+    working size, to .onnx.
 
     Raises ValueError for an unknown extension, an option of the other format or a hand-crafted fill (nothing
     learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the
     model loads."""
     onnx = export_format(out) == ".onnx"
-    wrong = ("--platforms", platforms, ".stablehlo") if onnx else ("--samples", samples, ".onnx")
+    wrong = ("--platforms", platforms, ".stablehlo") if onnx else \
+        ("--samples" if samples is not None else "--scattered", samples or scattered or None, ".onnx")
     if wrong[1] is not None:
         raise ValueError(f"{wrong[0]} applies to {wrong[2]} exports only; drop it for {os.fspath(out)}")
     need_onnx() if onnx else _need_flatbuffers()
@@ -186,7 +189,8 @@ def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int
         raise ValueError(f"--model {completer.name}: a hand-crafted fill has no learned model to export; export a "
                          "shipped model (lipjax models) or a saved model path")
     if onnx:
-        return export_onnx(completer, out, height=height, width=width, batch=batch, samples=samples)
+        return export_onnx(completer, out, height=height, width=width, batch=batch, samples=samples,
+                           scan_lines=not scattered)
     exported = export_completer(completer, batch, height, width, platforms=platforms)
     path = save_exported(exported, out)
     return ExportedFile(path, exported, completer.config.initial_estimate if len(exported.in_avals) == 3 else None)

@@ -15,9 +15,10 @@ jax.numpy, converted by lipjax.jaxpr_to_onnx (a translator of our own: jax2onnx 
 than the one lipjax trains with, see that module):
 
   1. the working size (h, w) is fixed at export: lipjax.resolution.working_size of (H, W) for `samples` samples
-     per frame (`export_working_size`). `lipjax.complete` picks it per frame from the frame's own sample count n;
-     it is the same (h, w) for every n in an interval (`samples_interval`), printed and stored in the metadata.
-     At 352x1216 and 480x640 that interval is every n from 125 up: the pixel cap MAX_WORKING_PIXELS decides.
+     per frame in LiDAR scan lines (default) or scattered (`scan_lines=False`, --scattered), `export_working_size`.
+     `lipjax.complete` picks it per frame from the frame's own sample count n and pattern; it is the same (h, w)
+     for every n in an interval (`samples_interval`), printed and stored in the metadata. For scan lines at
+     352x1216 and 480x640 that interval is every n from about 125 up: the pixel cap MAX_WORKING_PIXELS decides.
   2. rgb -> (h, w) as cv2.resize(INTER_AREA) and its uint8 rounding; sparse -> (h, w) by reprojection, the
      nearest depth winning (lipjax.resample: gathers with constant tables, mins and sums).
   3. z0, the initial fill, in the graph: the nearest-sample fill by jump flooding (lipjax.fill.jump_flood_nearest),
@@ -65,17 +66,18 @@ def default_samples(height: int, width: int) -> int:
     return max(1, round(height * width / DEFAULT_SPACING_PX**2))
 
 
-def export_working_size(height: int, width: int, samples: int) -> tuple[int, int]:
-    """(h, w) at which lipjax.complete runs a learned model on an (height, width) frame of `samples` samples."""
+def export_working_size(height: int, width: int, samples: int, scan_lines: bool = True) -> tuple[int, int]:
+    """(h, w) at which lipjax.complete runs a learned model on an (height, width) frame of `samples` samples, in
+    LiDAR scan lines or scattered."""
     if not 1 <= samples <= height * width:
         raise ValueError(f"--samples {samples}: give the number of depth samples per frame, 1 to {height * width}")
-    return working_size((height, width), math.sqrt(height * width / samples))
+    return working_size((height, width), math.sqrt(height * width / samples), scan_lines=scan_lines)
 
 
-def samples_interval(height: int, width: int, samples: int) -> tuple[int, int]:
-    """(lo, hi): the sample counts n for which lipjax.complete picks the same working size as for `samples`. The
-    size never shrinks as n grows, so they are an interval, found by bisection."""
-    size, n_max = export_working_size(height, width, samples), height * width
+def samples_interval(height: int, width: int, samples: int, scan_lines: bool = True) -> tuple[int, int]:
+    """(lo, hi): the sample counts n for which lipjax.complete picks the same working size as for `samples` (of
+    the same pattern). The size never shrinks as n grows, so they are an interval, found by bisection."""
+    size, n_max = export_working_size(height, width, samples, scan_lines), height * width
 
     def first(lo: int, hi: int, is_past) -> int:  # the smallest n in [lo, hi] with is_past(n); is_past(hi) holds
         while lo < hi:
@@ -83,8 +85,11 @@ def samples_interval(height: int, width: int, samples: int) -> tuple[int, int]:
             lo, hi = (lo, mid) if is_past(mid) else (mid + 1, hi)
         return lo
 
-    low = first(1, samples, lambda n: export_working_size(height, width, n) == size)
-    high = first(samples, n_max + 1, lambda n: n > n_max or export_working_size(height, width, n) != size) - 1
+    def same(n: int) -> bool:
+        return export_working_size(height, width, n, scan_lines) == size
+
+    low = first(1, samples, same)
+    high = first(samples, n_max + 1, lambda n: n > n_max or not same(n)) - 1
     return low, high
 
 
@@ -135,7 +140,7 @@ class OnnxFile:
         lines = [f"wrote {self.path} ({self.path.stat().st_size} bytes): rgb uint8 {(b, h, w, 3)}, sparse float32 "
                  f"{(b, h, w)} m -> depth float32 {(b, h, w)} m (ONNX opset {jaxpr_to_onnx.OPSET}, fixed shape)",
                  f"working size {self.working[0]}x{self.working[1]}: lipjax.complete's for {self.samples[0]} to "
-                 f"{self.samples[1]} samples per frame (--samples sets it)"]
+                 f"{self.samples[1]} samples per frame (--samples and --scattered set it)"]
         if self.replaced_fill:
             lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
                          "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
@@ -151,9 +156,10 @@ def need_onnx() -> None:
 
 
 def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
-                samples: int | None = None) -> OnnxFile:
+                samples: int | None = None, scan_lines: bool = True) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
-    `default_samples`) to `out`. ImportError without the onnx package."""
+    `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`. ImportError without the
+    onnx package."""
     need_onnx()
     import onnx
 
@@ -161,13 +167,13 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
         if int(value) < 1:
             raise ValueError(f"{name} must be >= 1, got {value}")
     samples = default_samples(height, width) if samples is None else samples
-    working = export_working_size(height, width, samples)
-    interval = samples_interval(height, width, samples)
+    working = export_working_size(height, width, samples, scan_lines)
+    interval = samples_interval(height, width, samples, scan_lines)
     fill = getattr(completer.config, "initial_estimate", None)
     replaced = fill if fill in ("linear", "auto") else None
     metadata = {"lipjax_model": completer.name, "units": "metres; sparse 0 = no sample",
                 "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
-                "working_size_samples": f"{interval[0]}-{interval[1]}",
+                "working_size_samples": f"{interval[0]}-{interval[1]}" + ("" if scan_lines else " scattered"),
                 "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else "")}
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]

@@ -1,6 +1,8 @@
 """The ONNX export (lipjax.onnx_export, lipjax.jaxpr_to_onnx): under onnxruntime it computes what JAX computes,
 primitive by primitive and for a whole model, and equals `lipjax.complete` wherever the fill in its graph is the
 model's own."""
+import math
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -12,6 +14,7 @@ from lipjax.inputs import is_lidar_pattern
 from lipjax.model import LIPConfig
 from lipjax.onnx_export import (export_onnx, export_working_size, inference_graph, nearest_twin, samples_interval)
 from lipjax.priors.guided import PRESETS
+from lipjax.resolution import MAX_WORKING_PIXELS, working_size
 
 pytest.importorskip("onnx")
 ort = pytest.importorskip("onnxruntime")
@@ -60,10 +63,16 @@ def test_an_untranslated_primitive_is_a_one_line_error():
 
 
 def test_the_working_size_is_fixed_from_the_sample_count_for_an_interval_of_counts():
-    assert export_working_size(352, 1216, 20000) == (132, 455)
+    size = export_working_size(352, 1216, 20000)  # a 64-beam scan: the scan lines' pixel cap decides
+    assert size == working_size((352, 1216), math.sqrt(352 * 1216 / 20000), scan_lines=True)
+    assert size[0] * size[1] == pytest.approx(MAX_WORKING_PIXELS, rel=0.01)
     lo, hi = samples_interval(352, 1216, 20000)
-    assert (lo, hi) == (124, 352 * 1216)  # the pixel cap decides from 124 samples up
-    assert export_working_size(352, 1216, lo - 1) != (132, 455)
+    assert hi == 352 * 1216 and 1 < lo < 20000 and export_working_size(352, 1216, lo) == size
+    assert export_working_size(352, 1216, lo - 1) != size
+    # as many scattered points: no cap, the full size, for every count whose spacing is under about 22 px
+    assert export_working_size(352, 1216, 20000, scan_lines=False) == (352, 1216)
+    lo, hi = samples_interval(352, 1216, 20000, scan_lines=False)
+    assert hi == 352 * 1216 and export_working_size(352, 1216, lo - 1, scan_lines=False) != (352, 1216)
     lo, hi = samples_interval(128, 160, 10)
     assert export_working_size(128, 160, 10) == (64, 80)
     assert all(export_working_size(128, 160, n) == (64, 80) for n in (lo, hi))
@@ -120,3 +129,12 @@ def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_mo
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
     expected = np.stack([lipjax.complete(c, s, model=auto_model) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
+
+
+@pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}])
+def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_path):
+    from lipjax.export import export
+
+    name = "--samples" if "samples" in option else "--scattered"
+    with pytest.raises(ValueError, match=f"^{name} applies to .onnx exports only; drop it"):
+        export("linear", tmp_path / "m.stablehlo", height=8, width=8, **option)
