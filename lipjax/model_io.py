@@ -153,9 +153,9 @@ def listing() -> str:
     if not available():
         return (f"no shipped models in {WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. Train one "
                 "with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
-    return (table(DEFAULT_MODELS) + "\n\nDEFAULT: lipjax complete picks the indoor default for scattered samples, "
-            "the outdoor default for LiDAR scan lines\nor a median sample depth over 12 m; --model NAME overrides "
-            "it. TYPE: LIP and its prox, or an end-to-end network.")
+    return (table(DEFAULT_MODELS) + "\n\nDEFAULT: the inputs lipjax complete gives the model (indoor: scattered "
+            "samples; outdoor: LiDAR scan lines\nor a median sample depth over 12 m); --model NAME overrides it. "
+            "TYPE: LIP and its prox, or an end-to-end network.")
 
 
 def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:

@@ -110,15 +110,16 @@ def test_lidar_pattern_and_scene():
     assert suggest_scene(np.zeros((4, 4), np.float32)) == "indoor"
 
 
-def test_default_model_follows_the_input():
-    assert methods.get_completer(sparse=_lidar(20.0)).name == "lip-ad-fast-outdoor"
-    assert methods.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-fast-indoor"
-    assert methods.get_completer().name == "lip-fast-indoor"
+def test_one_default_model_for_rooms_and_streets():
+    """Issue 22: the same model for a room with 200 points and a street with 64 scan lines (DEFAULT_MODELS)."""
+    assert methods.get_completer(sparse=_lidar(20.0)).name == "lip-any"
+    assert methods.get_completer(sparse=_scattered(0.5, 8.0)).name == "lip-any"
+    assert methods.get_completer().name == "lip-any"
 
 
 def test_the_completer_checks_against_its_range():
     rgb = np.zeros((96, 200, 3), np.uint8)
-    with pytest.warns(UserWarning, match="looks like outdoor data, use lip-ad-fast-outdoor"):
+    with pytest.warns(UserWarning, match="looks like outdoor data, use lip-any"):
         lipjax.Completer.random()(rgb, _lidar(20.0))
     with pytest.raises(InputError, match="over 10x the 10 m range of random"):
         lipjax.Completer.random()(rgb, _lidar(300.0))

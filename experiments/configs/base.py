@@ -49,16 +49,19 @@ OUTDOOR_DATA = DataConfig(
     val_sampler="lidar:hdl64", val_images=32,
 )
 # Rooms and streets interleaved, both rendered at 256x320: 50 to 5,000 scattered points, 16- to 64-beam scans at
-# random mount pitch, noise and bleed-through outliers on some, colour texture without depth edges.
+# random mount pitch, noise and bleed-through outliers on some, colour texture without depth edges, camera noise.
 MIXED_SAMPLER = "|".join((
     "uniform:50", "uniform:200", "uniform:200", "uniform:500", "uniform:1000", "uniform:5000", "bernoulli:2000",
     "uniform:300+noise:rel=0.01,outliers=0.03",
     "lidar:hdl64,azimuth_step_deg=0.4", "lidar:vlp32,azimuth_step_deg=0.3,mount_pitch_deg=-3",
     "lidar:vlp16,azimuth_step_deg=0.4,mount_pitch_deg=2", "lidar:hdl64+noise:rel=0.005,outliers=0.02",
 ))
+# Zoom 0.5 shows whole 256x320 frames at half scale (KITTI-size streets at their working size); texture and camera
+# noise against the renders' clean, flat surfaces (docs/design-notes.md, "RGB guidance from renders to photographs").
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
-    augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.6, 1.6), texture_prob=0.3),
+    augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.5, 1.6), texture_prob=0.8, texture_strength=0.7,
+                                sensor_noise=0.02, jpeg_prob=0.3),
 )
 
 # z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest
