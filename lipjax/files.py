@@ -95,8 +95,8 @@ COMPLETE_HELP = """\
             XLA's threads; `taskset -c 0,1 lipjax ...` works as well and picks the cores.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
-in training, at most 100,000 pixels for LiDAR scan lines (200 points on 640x480 run at 359x269; a 64-beam KITTI
-scan at 575x174; dense scattered samples at full size); a
+in training, at most 60,000 pixels for LiDAR scan lines (200 points on 640x480 run at 261x196; a 64-beam KITTI
+scan at 455x132; dense scattered samples at full size); a
 new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
 pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
 averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured values

@@ -12,23 +12,27 @@ training saw, and only there:
                                                               MAX_WORKING_PIXELS pixels
     (h, w)     = round(s H), round(s W), the shorter side at least MIN_WORKING_SIDE_PX
 
-Sparse inputs (200 points on 480x640: 39 px apart) run at 0.56x (270x360). Dense scattered ones (1,000 points or
+Sparse inputs (200 points on 480x640: 39 px apart) run at 0.41x (196x261). Dense scattered ones (1,000 points or
 more on 480x640, 30 % of a KITTI frame's valid pixels) already lie closer than TARGET_SPACING_PX and run at full
 size. A LiDAR scan (64 beams, ~5 px apart on a KITTI frame) also lies closer, but a KITTI-size frame still runs
-below full size (0.48x, 168x580): the prox's receptive field and its training frames (128x160 crops) cover a fixed
+below full size (0.38x, 132x455): the prox's receptive field and its training frames (128x160 crops) cover a fixed
 number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow slice of the street
 (the rows between beams, the sky above the top beam). Scattered samples carry no such structure, and capping them
 only throws their detail away. The data-consistency step and the output stay at full resolution
 (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every measured pixel is set back to its
 measured value (the x-update with rho -> 0 at m = 1).
 
-The constants were chosen on synthetic renders larger than the training frames, by a rule fixed before any real
-frame was scored (`python benchmarks/working_resolution.py --model lip-any --frames 6`): T and the cap of scattered
-samples minimise the geometric-mean RMSE ratio to the full-size linear fill over 50 to 5,000 points on 480x640 rooms
-and 200 or 25,000 points on 352x1216 streets (T=22 px, no cap: 0.813; the earlier single cap of 60,000 pixels:
-0.860); the scan-line cap minimises it over 64- and 32-beam scans on those streets (100,000 pixels: 0.697; 60,000:
-0.701; native size: 0.809). Per setting, native size -> rule: 64-beam streets 0.690 -> 0.529, 200 points on rooms
-0.954 -> 0.819, 50 points 1.321 -> 0.813, 25,000 points on streets 0.892 (native; capped at 60,000 pixels 1.051).
+The constants were chosen on synthetic renders larger than the training frames (`python
+benchmarks/working_resolution.py --model lip-any --frames 6`, geometric-mean RMSE ratio to the full-size linear fill
+over 50 to 5,000 points on 480x640 rooms and 200 or 25,000 points on 352x1216 streets for T and the scattered cap;
+over 64- and 32-beam scans on those streets for the scan-line cap), as the most accurate rule whose frames meet the
+speed target of 10 frames/s (normalised to 195 GFLOP/s, benchmarks/speed.py) at 640x480 with 200 points and at
+352x1216 with 64 beams. Unconstrained, the best were T=22 px without a cap for scattered samples (0.813) and a
+100,000-pixel cap for scan lines (0.697), but those frames took 49 and 45 ms (8.8 and 9.7 frames/s normalised);
+the rule's T=16 px (0.816) and 60,000 pixels (0.701) are within 0.6 % of them. The earlier rule, one cap of 60,000
+pixels for every input, scored 0.860 on the scattered settings: it ran 25,000 points on a street at 0.37x (1.051x
+linear against 0.892x at full size). Per setting, native size -> rule: 64-beam streets 0.690 -> 0.534, 200 points
+on rooms 0.954 -> 0.821, 50 points 1.321 -> 0.805.
 """
 from __future__ import annotations
 
@@ -36,8 +40,8 @@ import math
 
 import numpy as np
 
-TARGET_SPACING_PX = 22.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
-MAX_WORKING_PIXELS = 100_000  # the largest working size of LiDAR scan lines, pixels (see the module doc)
+TARGET_SPACING_PX = 16.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
+MAX_WORKING_PIXELS = 60_000  # the largest working size of LiDAR scan lines, pixels (see the module doc)
 MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
 MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
 MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cost more than it brings
