@@ -7,14 +7,14 @@ Run by hand (never a test; needs onnxruntime):
 
 Default: the KITTI frames under --realdata (read here, never copied into the repository), cropped to 352x1216 as
 the depth-completion selection (protocol kitti_selection), the HDL-64 pattern drawn on their ground truth as
-benchmarks/baselines.py does (LidarSampler.hdl64(), seed 0); the model (default: the default outdoor one)
+benchmarks/baselines.py does (LidarSampler.hdl64(), seed 0); the model (default: the default outdoor one, lip-any)
 exported at 352x1216 (`lipjax export`'s default --samples), run under onnxruntime (CPU) and compared with
 `lipjax.complete(rgb, sparse, model)`.
 Printed per frame: samples, median, 99th percentile and max |ONNX - complete| over all pixels, in mm.
 
 --scattered: synthetic rooms (lipjax.data renders, test split) at 480x640 with 200 uniform points, where a model
 whose initial fill is "linear" or "auto" runs from the Delaunay fill under lipjax.complete but from the nearest
-fill in the graph (default model: the default indoor one, "linear"). Printed per room: the RMSE against the
+fill in the graph (default model: the default indoor one; lip-any, "auto"). Printed per room: the RMSE against the
 rendered depth (metres) of the ONNX graph, of lipjax.complete with the model as shipped and with its nearest twin
 (lipjax.onnx_export.nearest_twin), and |ONNX - each|; then the mean RMSEs.
 """
@@ -66,7 +66,8 @@ def scattered(model: str, frames: int, out: str) -> None:
     from lipjax.data.synthetic import render
 
     completer = get_completer(model)
-    written = export_onnx(completer, os.path.join(out, "room.onnx"), height=480, width=640, samples=200)
+    written = export_onnx(completer, os.path.join(out, "room.onnx"), height=480, width=640, samples=200,
+                          scan_lines=False)
     print(written.summary())
     session = _session(os.fspath(written.path))
     methods = (("ONNX", None), ("lipjax.complete as shipped", completer),

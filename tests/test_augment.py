@@ -8,6 +8,7 @@ from lipjax.data.augment import (
     DEFAULT_TRAINING,
     Augment,
     augment_batch,
+    camera_noise,
     move_samples,
     paint_texture,
     perturb_samples,
@@ -120,8 +121,35 @@ def test_texture_paints_the_rgb_of_a_rectangle_and_nothing_else():
     np.testing.assert_array_equal(plain.rgb, off.rgb)
 
 
+def test_camera_noise_statistics_and_jpeg():
+    """Noise of std U(0, a) * 255 per pixel: on a mid-grey frame the residual's std is below a * 255 and its mean is
+    0; a JPEG round trip alone changes a textured frame by a few grey levels and leaves a flat one as it was; off:
+    the frame as it was. Depth and samples never change (the RGB is the only input)."""
+    flat = np.full((64, 64, 3), 128, np.uint8)
+    stds = [float((camera_noise(flat, Augment(sensor_noise=0.05), np.random.default_rng(s)).astype(float) - 128)
+                  .std()) for s in range(30)]
+    assert max(stds) <= 0.05 * 255 * 1.05 and min(stds) < 0.3 * max(stds)  # sigma drawn in (0, 0.05 * 255)
+    assert abs(np.mean(stds) - 0.025 * 255) < 0.01 * 255  # E[U(0, a)] = a / 2
+    noisy = camera_noise(flat, Augment(sensor_noise=0.05), np.random.default_rng(0)).astype(float) - 128
+    assert abs(noisy.mean()) < 0.5
+    np.testing.assert_array_equal(camera_noise(flat, Augment(jpeg_prob=1.0), np.random.default_rng(0)), flat)
+    textured = np.random.default_rng(1).integers(0, 256, (64, 64, 3), dtype=np.uint8)
+    jpeg = camera_noise(textured, Augment(jpeg_prob=1.0), np.random.default_rng(0))
+    assert jpeg.shape == textured.shape and jpeg.dtype == np.uint8 and not np.array_equal(jpeg, textured)
+    np.testing.assert_array_equal(camera_noise(textured, Augment(), np.random.default_rng(0)), textured)
+    b = _batch(n=3)
+    plain = augment_batch(b, DEFAULT_TRAINING, (24, 32), seed=1, step=5)
+    noisy_batch = augment_batch(b, dataclasses.replace(DEFAULT_TRAINING, sensor_noise=0.02, jpeg_prob=1.0), (24, 32),
+                                seed=1, step=5)
+    for name in ("gt", "sparse", "gt_valid"):
+        np.testing.assert_array_equal(getattr(plain, name), getattr(noisy_batch, name))
+    assert not np.array_equal(plain.rgb, noisy_batch.rgb)
+
+
 def test_bad_settings_are_clear_errors():
     with pytest.raises(ValueError, match="zoom"):
         Augment(zoom=(1.5, 1.0))
     with pytest.raises(ValueError, match="brightness"):
         dataclasses.replace(DEFAULT_TRAINING, brightness=1.5)
+    with pytest.raises(ValueError, match="sensor_noise"):
+        Augment(sensor_noise=1.5)
