@@ -9,7 +9,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N [--scattered]] --out FILE.onnx
+    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] [--scattered] --out FILE
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version

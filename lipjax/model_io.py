@@ -123,10 +123,17 @@ def metadata(name_or_path: str | os.PathLike) -> dict:
 TABLE_COLUMNS = ("MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL RMSE", "VALIDATED ON", "TRAINED ON")
 
 
+def default_mark(defaults: dict[str, str], name: str) -> str:
+    """The DEFAULT cell of model `name`: the scenes whose default it is (`defaults`: scene -> model name), "all"
+    when it is the default of every scene, blank for none."""
+    scenes = [s for s, m in defaults.items() if m == name]
+    return "all" if len(scenes) == len(defaults) > 1 else ", ".join(scenes)
+
+
 def table(defaults: dict[str, str]) -> str:
     """The shipped models as a text table in aligned columns (TABLE_COLUMNS), one row per model, from each model's
-    config and metadata: DEFAULT names the scene(s) whose default it is (`defaults`: scene -> model name, e.g.
-    lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
+    config and metadata: DEFAULT names the scene(s) whose default it is (`default_mark`; `defaults`: scene ->
+    name, e.g. lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
     type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
     (its sampler); "-" where unknown or not applicable."""
     rows = [TABLE_COLUMNS]
@@ -139,7 +146,7 @@ def table(defaults: dict[str, str]) -> str:
             kind, iters, z0 = f"LIP, {prior}", str(config.num_iterations), config.initial_estimate
         else:
             kind, iters, z0 = model_type_name(config), "-", "-"
-        rows.append((name, ", ".join(s for s, m in defaults.items() if m == name), kind, iters, z0,
+        rows.append((name, default_mark(defaults, name), kind, iters, z0,
                      f"{config.max_depth_m:g} m", "-" if rmse is None else f"{rmse:.4f} m",
                      meta.get("val_sampler", "-"),
                      f"{meta['images_seen']:,} images" if "images_seen" in meta else "-"))

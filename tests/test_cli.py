@@ -399,8 +399,10 @@ def test_models_command_is_a_table_in_aligned_columns_marking_every_default(caps
         assert all(row[a - 1] == " " for a in starts[1:-1] if a < len(row)), row
     assert [c[0] for c in cells] == lipjax.available_models() and "None" not in "".join(rows)
     defaults = {c[0]: c[1] for c in cells if c[1]}
-    marks = {name: ", ".join(s for s, m in DEFAULT_MODELS.items() if m == name) for name in DEFAULT_MODELS.values()}
+    marks = {name: model_io.default_mark(DEFAULT_MODELS, name) for name in DEFAULT_MODELS.values()}
     assert defaults == marks  # each default marked with its scene(s), and only they
+    assert model_io.default_mark({"indoor": "a", "outdoor": "a"}, "a") == "all"
+    assert model_io.default_mark({"indoor": "a", "outdoor": "b"}, "b") == "outdoor"
     for c in cells:
         assert c[2].startswith("LIP, ") and c[3].isdigit() or c[3] == c[4] == "-", c
         assert c[5] in ("10 m", "85 m") and c[6].endswith(" m") and c[8].endswith(" images"), c
