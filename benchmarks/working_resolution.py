@@ -8,11 +8,12 @@ with 50, 200, 1,000 and 5,000 uniform points on the rooms, and 64- and 32-beam s
 runs at `lipjax.resolution.working_size(shape, spacing, T, P)`, and the table gives the geometric-mean RMSE ratio to
 the full-size linear fill on the unsampled valid pixels (< 1: the model wins).
 
-The rule, fixed before any real frame is scored: T (TARGET_SPACING_PX) and the pixel cap of scattered samples
-(MAX_WORKING_PIXELS["scattered"]) are the (T, P) with the lowest geometric mean over the scattered settings; the cap
-of LiDAR scan lines (MAX_WORKING_PIXELS["scan_lines"]) is the P with the lowest geometric mean over the scan-line
-settings at that T (`lipjax.inputs.is_lidar_pattern` tells them apart, as the default path does). Real frames are
-scored afterwards, with that rule (benchmarks/real_frames.py).
+The rule, fixed before any real frame is scored: T (TARGET_SPACING_PX) and the pixel cap of scattered samples are the
+(T, P) with the lowest geometric mean over the scattered settings; the cap of LiDAR scan lines (MAX_WORKING_PIXELS)
+is the P with the lowest geometric mean over the scan-line settings at that T (`lipjax.inputs.is_lidar_pattern`
+tells them apart, as the default path does). Among rules within 1 % of those, lipjax.resolution takes the most
+accurate one whose frames keep 10 frames/s (benchmarks/speed.py): T=16 px, no cap for scattered samples, 60,000
+pixels for scan lines. Real frames are scored afterwards (benchmarks/real_frames.py).
 """
 from __future__ import annotations
 
