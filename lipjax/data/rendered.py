@@ -162,6 +162,21 @@ def _sigterm_as_exit():
         signal.signal(signal.SIGINT, previous_int)
 
 
+@contextlib.contextmanager
+def _sigint_ignored():
+    """SIGINT ignored while processes are spawned: a spawned process inherits the ignored signal through exec and
+    Python keeps it ignored at start-up, so a Ctrl-C can never reach a worker before `_render_worker_init` runs.
+    No-op outside the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def _index(spec: RenderSpec) -> dict:
     from lipjax.data.synthetic import intrinsics_for
 
@@ -218,7 +233,8 @@ def render_to_disk(kind: str, split: str, count: int, out: str | os.PathLike, *,
                 bar.update(_render_shard(spec, shard, str(out)))
         else:
             context = multiprocessing.get_context("spawn")  # no inherited threads or jax state
-            pool = context.Pool(workers, initializer=_render_worker_init)
+            with _sigint_ignored():  # a worker still starting up would print a KeyboardInterrupt traceback
+                pool = context.Pool(workers, initializer=_render_worker_init)
             try:
                 for done in pool.imap_unordered(functools.partial(_render_shard, spec, out=str(out)),
                                                 range(spec.num_shards)):
