@@ -54,6 +54,7 @@ import numpy as np
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
 from lipjax.inference import Completer
+from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import working_size
 
@@ -113,10 +114,16 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
     return run
 
 
+def _host_fill(config) -> str | None:
+    """The model's initial fill when it has no in-graph form ("linear" or "auto"), else None."""
+    fill = config.initial_estimate if isinstance(config, LIPConfig) else None
+    return fill if fill in ("linear", "auto") else None
+
+
 def nearest_twin(completer: Completer) -> Completer:
     """The model with the initial fill its ONNX export computes: "nearest" where it is computed on the host."""
     config = completer.config
-    if getattr(config, "initial_estimate", None) not in ("linear", "auto"):
+    if _host_fill(config) is None:
         return completer
     return Completer(dataclasses.replace(config, initial_estimate="nearest"), completer.params, completer.name,
                      completer.metadata)
@@ -169,8 +176,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
     samples = default_samples(height, width) if samples is None else samples
     working = export_working_size(height, width, samples, scan_lines)
     interval = samples_interval(height, width, samples, scan_lines)
-    fill = getattr(completer.config, "initial_estimate", None)
-    replaced = fill if fill in ("linear", "auto") else None
+    replaced = _host_fill(completer.config)
     metadata = {"lipjax_model": completer.name, "units": "metres; sparse 0 = no sample",
                 "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
                 "working_size_samples": f"{interval[0]}-{interval[1]}" + ("" if scan_lines else " scattered"),
