@@ -51,6 +51,8 @@ def write_frames(root: Path, count: int) -> None:
     """rgb/ and depth/ PNGs of outdoor test frames 0 .. count-1 (depth: the HDL-64 pattern, 1/256 m steps)."""
     for sub in ("rgb", "depth"):
         (root / sub).mkdir(parents=True, exist_ok=True)
+    if all((root / sub / f"{i:06d}.png").exists() for sub in ("rgb", "depth") for i in range(count)):
+        return  # kept from an earlier run (--keep)
     sampler = LidarSampler.hdl64()
     for i in range(count):
         sample = render("outdoor", "test", i, HEIGHT, WIDTH)
@@ -76,7 +78,7 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="default: the model lipjax complete picks (the outdoor default)")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--threads", type=int, default=None)
-    ap.add_argument("--keep", default=None, metavar="DIR", help="write the frames and outputs here, and keep them")
+    ap.add_argument("--keep", default=None, metavar="DIR", help="write the frames and outputs here, and keep them (frames already there are reused)")
     args = ap.parse_args(argv)
     if args.threads:
         limit_cpu_threads(args.threads)

@@ -84,7 +84,7 @@ def test_encoder_and_branch_equal_the_nn_conv_groupnorm_formulation(widths):
         np.testing.assert_equal(jax.tree_util.tree_map(np.asarray, new.init(jax.random.key(0), *args)["params"]),
                                 jax.tree_util.tree_map(np.asarray, params))
         params = _scramble(params)  # a non-zero head, non-trivial GroupNorm scales and biases
-        out, expected = new.apply({"params": params}, *args), ref.apply({"params": params}, *args)
+        out, expected = (jax.jit(m.apply)({"params": params}, *args) for m in (new, ref))
         for a, b in zip(jax.tree_util.tree_leaves(out), jax.tree_util.tree_leaves(expected), strict=True):
             np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5 * float(np.abs(b).max()))
         # and the same gradients, for training (relative to the largest: some are zero up to rounding)
@@ -92,7 +92,7 @@ def test_encoder_and_branch_equal_the_nn_conv_groupnorm_formulation(widths):
             def loss(p):
                 return sum((a**2).mean() for a in jax.tree_util.tree_leaves(m.apply({"params": p}, *args)))
 
-            return jax.tree_util.tree_leaves(jax.grad(loss)(params))
+            return jax.tree_util.tree_leaves(jax.jit(jax.grad(loss))(params))
 
         expected = grads(ref)
         scale = max(float(np.abs(b).max()) for b in expected)
