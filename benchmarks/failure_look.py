@@ -98,7 +98,8 @@ def print_table(title: str, rows: list[dict]) -> None:
     print("|---|---|---:|---:|" + "---|" * len(CLASSES))
     for r in rows:
         cells = [f"{r[f'share {c}']:.0%}, {r[f'model-linear {c}']:+.3f}, {r[f'rgb-grey {c}']:+.3f}" for c in CLASSES]
-        print(f"| {r['frame']} | {r['input']} | {r['ratio']:.3f} | {r['grey_ratio']:.3f} | " + " | ".join(cells) + " |")
+        print(f"| {r['frame']} | {r['input']} | {r['ratio']:.3f} | {r['grey_ratio']:.3f} | " + " | ".join(cells)
+              + " |")
     mean = {k: np.mean([r[k] for r in rows]) for k in rows[0] if k not in ("frame", "input")}
     print("| mean | | {ratio:.3f} | {grey_ratio:.3f} | ".format(**mean) + " | ".join(
         f"{mean[f'share {c}']:.0%}, {mean[f'model-linear {c}']:+.3f}, {mean[f'rgb-grey {c}']:+.3f}"

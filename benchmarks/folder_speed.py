@@ -78,7 +78,8 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="default: the model lipjax complete picks (the outdoor default)")
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--threads", type=int, default=None)
-    ap.add_argument("--keep", default=None, metavar="DIR", help="write the frames and outputs here, and keep them (frames already there are reused)")
+    ap.add_argument("--keep", default=None, metavar="DIR",
+                    help="write the frames and outputs here, and keep them (frames already there are reused)")
     args = ap.parse_args(argv)
     if args.threads:
         limit_cpu_threads(args.threads)
