@@ -13,6 +13,7 @@ from lipjax.data.augment import (
     paint_texture,
     perturb_samples,
     photometric,
+    relight,
 )
 from lipjax.data.sample import Batch
 
@@ -146,6 +147,31 @@ def test_camera_noise_statistics_and_jpeg():
     assert not np.array_equal(plain.rgb, noisy_batch.rgb)
 
 
+def test_relight_is_one_smooth_grey_gain_within_the_strength_and_leaves_depth_alone():
+    """relight multiplies every channel by the same gain exp(a f), |a f| <= strength, with f smooth: on a mid-grey
+    frame out / in (before rounding) has |log| <= strength, and its log changes by at most strength * 2 * (ramp
+    slope 2 / side + the bicubic grid's slope) per pixel, i.e. no colour edge; in the batch only the RGB changes."""
+    h, w = 60, 80
+    grey = np.full((h, w, 3), 100, np.uint8)
+    changed = 0
+    for seed in range(20):
+        out = relight(grey, 0.7, np.random.default_rng(seed)).astype(float)
+        assert (out[..., 0] == out[..., 1]).all() and (out[..., 1] == out[..., 2]).all()
+        log_gain = np.log(out[..., 0] / 100.0)
+        assert np.abs(log_gain).max() <= 0.7 + 0.01  # rounding to integers: <= 0.5 / 50 in log
+        steps = max(np.abs(np.diff(log_gain, axis=0)).max(), np.abs(np.diff(log_gain, axis=1)).max())
+        assert steps <= 0.2, steps  # a step edge would be up to 1.4 here: |a f| jumps over 2 * 0.7
+        changed += int(np.abs(log_gain).max() > 0.05)
+    assert changed >= 15  # a zero amplitude is rare
+    np.testing.assert_array_equal(relight(grey, 0.0, np.random.default_rng(0)), grey)
+    b = _batch(n=3)
+    plain = augment_batch(b, DEFAULT_TRAINING, (24, 32), seed=1, step=5)
+    lit = augment_batch(b, dataclasses.replace(DEFAULT_TRAINING, illumination_prob=1.0), (24, 32), seed=1, step=5)
+    for name in ("gt", "sparse", "gt_valid"):
+        np.testing.assert_array_equal(getattr(plain, name), getattr(lit, name))
+    assert not np.array_equal(plain.rgb, lit.rgb)
+
+
 def test_bad_settings_are_clear_errors():
     with pytest.raises(ValueError, match="zoom"):
         Augment(zoom=(1.5, 1.0))
@@ -153,3 +179,5 @@ def test_bad_settings_are_clear_errors():
         dataclasses.replace(DEFAULT_TRAINING, brightness=1.5)
     with pytest.raises(ValueError, match="sensor_noise"):
         Augment(sensor_noise=1.5)
+    with pytest.raises(ValueError, match="illumination"):
+        Augment(illumination_prob=2.0)

@@ -57,11 +57,12 @@ MIXED_SAMPLER = "|".join((
     "lidar:vlp16,azimuth_step_deg=0.4,mount_pitch_deg=2", "lidar:hdl64+noise:rel=0.005,outliers=0.02",
 ))
 # Zoom 0.5 shows whole 256x320 frames at half scale (KITTI-size streets at their working size); texture and camera
-# noise against the renders' clean, flat surfaces (docs/design-notes.md, "RGB guidance from renders to photographs").
+# noise against the renders' clean, flat surfaces, and light that follows no geometry (docs/design-notes.md, "RGB
+# guidance from renders to photographs").
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
     augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.5, 1.6), texture_prob=0.8, texture_strength=0.7,
-                                sensor_noise=0.02, jpeg_prob=0.3),
+                                sensor_noise=0.02, jpeg_prob=0.3, illumination_prob=0.5, illumination_strength=0.7),
 )
 
 # z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest

@@ -1,4 +1,4 @@
-"""Training-time augmentation of a batch: random zoomed crop, flip, photometric jitter, blur, sensor noise, outliers.
+"""Training-time augmentation of a batch: zoomed crop, flip, texture, light, photometric jitter, blur, noise, outliers.
 
     batch = augment_batch(batch, Augment(...), seed, step, first_example)
 
@@ -27,6 +27,12 @@ What each part is for (real sensors and real frames differ from the synthetic re
   nowhere in the depth (`paint_texture`): real surfaces carry print, grain and clutter that the renders' flat
   materials lack, so a prox trained on renders alone learns that every colour edge is a depth edge and, on
   real frames (e.g. Middlebury's shelves), invents depth steps at texture.
+- illumination: with probability `illumination_prob`, the RGB times a smooth random gain field exp(a f), f in
+  [-1, 1], a in [0, illumination_strength] (`relight`): a photograph's brightness varies smoothly with its lights
+  (a lamp's falloff on a wall, a window, a shadow's penumbra) without any change of depth, while the renders'
+  shading follows their geometry, so a prox trained on renders alone reads brightness gradients on flat ground as
+  shape (benchmarks/failure_look.py: on the shared frames the photograph costs RMSE on flat ground, the grey
+  image does better there).
 Ground truth is only cropped, zoomed and flipped: the model learns to undo the noise and the outliers.
 """
 from __future__ import annotations
@@ -60,6 +66,8 @@ class Augment:
     texture_strength: float = 0.4
     sensor_noise: float = 0.0
     jpeg_prob: float = 0.0
+    illumination_prob: float = 0.0
+    illumination_strength: float = 0.7
 
     def __post_init__(self):
         lo, hi = self.zoom
@@ -72,6 +80,8 @@ class Augment:
             raise ValueError("blur_prob, outlier_fraction and texture_prob are probabilities in [0, 1]")
         if not (0 <= self.sensor_noise < 1 and 0 <= self.jpeg_prob <= 1):
             raise ValueError("sensor_noise must be in [0, 1) and jpeg_prob in [0, 1]")
+        if not (0 <= self.illumination_prob <= 1 and self.illumination_strength >= 0):
+            raise ValueError("illumination_prob must be in [0, 1] and illumination_strength >= 0")
         if not 0 <= self.texture_strength < 1:
             raise ValueError(f"texture_strength must be in [0, 1), got {self.texture_strength}")
         if self.gamma < 0 or self.depth_noise < 0 or self.blur_sigma_px <= 0:
@@ -163,6 +173,27 @@ def paint_texture(rgb: np.ndarray, strength: float, rng: np.random.Generator) ->
     return np.clip(np.round(out), 0, 255).astype(np.uint8)
 
 
+ILLUMINATION_GRID = (2, 5)  # cells per side of the coarse random grid behind a gain field's blobs
+
+
+def relight(rgb: np.ndarray, strength: float, rng: np.random.Generator) -> np.ndarray:
+    """(H, W, 3) uint8 -> uint8 times a smooth gain exp(a f), a ~ U(0, strength), the same for the three channels.
+
+    f = (r + b) / max|r + b|: r a linear ramp of random direction across the frame, b uniform noise on a coarse
+    grid of ILLUMINATION_GRID cells per side, bicubically enlarged (light falloff, a window, a soft shadow).
+    f has no edges, so no colour edge is added, and depth is untouched."""
+    h, w = rgb.shape[:2]
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    theta = rng.uniform(0, 2 * np.pi)
+    ramp = (x / max(w - 1, 1) - 0.5) * np.cos(theta) + (y / max(h - 1, 1) - 0.5) * np.sin(theta)
+    cells = rng.integers(ILLUMINATION_GRID[0], ILLUMINATION_GRID[1] + 1, 2)
+    blobs = cv2.resize(rng.uniform(-1, 1, tuple(cells)).astype(np.float32), (w, h), interpolation=cv2.INTER_CUBIC)
+    field = ramp * rng.uniform(0, 2) + blobs
+    field = field / max(float(np.abs(field).max()), 1e-6)
+    gain = np.exp(rng.uniform(0, strength) * field)[..., None]
+    return np.clip(np.round(rgb.astype(np.float32) * gain), 0, 255).astype(np.uint8)
+
+
 JPEG_QUALITY = (30, 95)  # range of the JPEG round trip's quality setting
 
 
@@ -204,6 +235,8 @@ def augment_example(rgb, sparse, gt, valid, crop, aug: Augment, rng: np.random.G
         rgb, sparse, gt, valid = (a[:, ::-1] for a in (rgb, sparse, gt, valid))
     if aug.texture_prob and rng.random() < aug.texture_prob:  # on the surfaces, before the camera's effects
         rgb = paint_texture(np.ascontiguousarray(rgb), aug.texture_strength, rng)
+    if aug.illumination_prob and rng.random() < aug.illumination_prob:  # the scene's light, before the camera
+        rgb = relight(np.ascontiguousarray(rgb), aug.illumination_strength, rng)
     if aug.brightness or aug.contrast or aug.saturation or aug.gamma:
         rgb = photometric(rgb, aug, rng)
     if aug.blur_prob and rng.random() < aug.blur_prob:
