@@ -12,11 +12,11 @@ A folder overlaps reading, the model and writing: worker threads read and decode
 numpy's file reads release the GIL) while the model runs on the current one in the calling thread, and one background
 thread post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is
 loaded once and compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames
-(`python -m benchmarks.folder_speed`, 2 cores shared with a training run, load average 6-9) a folder ran at 16
-frames/s, 0.72x the warm single-frame rate (median of 15 runs, 0.53-0.94, 5 of them at 0.8 or more; 10 runs of
-the code before, interleaved with them: 12 frames/s, 0.52x). Per frame the model takes 37 ms of CPU, and a folder
-adds 17.5 ms that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1 (18.9 before);
-when the process gets one core in all, that bounds the ratio at 37 / 54.6 = 0.68. Every output file is written
+(`python benchmarks/folder_speed.py --keep DIR`, lip-any at 455x132) on the 2-core machine with nothing else
+running, a folder ran at 0.86x the warm single-frame rate (median of 7 runs, 0.78-0.87; single frame 44-48 ms);
+with the same 2 cores shared with a training run (load average 6-9) at 0.72x (median of 15 runs). Per frame a
+folder adds 17.5 ms of CPU that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1;
+with the model at 37 ms of CPU, one core in all bounds the ratio at 37 / 54.6 = 0.68. Every output file is written
 under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an
 unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the frames after
 it.
