@@ -15,6 +15,8 @@ from hypothesis import strategies as st
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import (
     BernoulliSampler,
+    HolesSampler,
+    KeypointSampler,
     LidarSampler,
     Noise,
     Noisy,
@@ -209,8 +211,10 @@ def test_sampler_from_spec():
     assert sampler_from_spec("lidar:vlp16") == LidarSampler.vlp16()
     s = sampler_from_spec("lidar:vlp32,azimuth_step_deg=0.4+noise:std=0.02,rel=0.01,outliers=0.05")
     assert s == Noisy(dataclasses.replace(LidarSampler.vlp32(), azimuth_step_deg=0.4), Noise(0.02, 0.01, 0.05))
+    assert sampler_from_spec("keypoint:500") == KeypointSampler(500)
+    assert sampler_from_spec("holes:0.3") == HolesSampler(0.3)
     for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1",
-                "uniform:3+blur:1"):
+                "uniform:3+blur:1", "holes:1.5", "holes:x", "keypoint:many"):
         with pytest.raises(ValueError):
             sampler_from_spec(bad)
 
@@ -222,3 +226,50 @@ def test_uniform_count_is_min_of_n_and_valid(n, hole_fraction, seed):
     sparse = UniformSampler(n)(sample, seed=seed)
     assert np.count_nonzero(sparse) == min(n, int(sample.valid.sum()))
     assert np.all(sample.valid[sparse > 0])
+
+
+# ---- keypoints / holes ---------------------------------------------------------------------------------------
+
+
+def _half_textured(h: int = 64, w: int = 96) -> Sample:
+    """A checkerboard of 8 px squares on the left half of the image, plain grey on the right; depth 2-5 m."""
+    rgb = np.full((h, w, 3), 128, np.uint8)
+    yy, xx = np.mgrid[0:h, 0 : w // 2]
+    rgb[:, : w // 2] = np.where(((yy // 8 + xx // 8) % 2 == 0)[..., None], 30, 220)
+    depth = np.linspace(2.0, 5.0, w, dtype=np.float32)[None].repeat(h, 0)
+    return Sample.from_depth(rgb, depth, Intrinsics(80, 80, w / 2, h / 2), "half")
+
+
+def test_keypoints_lie_on_corners_of_valid_pixels_with_their_depth():
+    """All 35 inner corners of the checkerboard and nothing on the plain half, at most N, with their depth;
+    pixels without depth give no point; the same points for the same (seed, id)."""
+    s = _half_textured()
+    out = KeypointSampler(40)(s, 0)
+    rows, cols = np.nonzero(out)
+    assert rows.size <= 40 and (cols <= 48).all()  # on the board or its border with the plain half, never inside it
+    np.testing.assert_array_equal(out[rows, cols], s.depth[rows, cols])
+    inner = {(r, c) for r in range(8, 64, 8) for c in range(8, 48, 8)}  # where four squares meet: 7 x 5
+    assert inner <= set(zip(rows.tolist(), cols.tolist()))
+    np.testing.assert_array_equal(out, KeypointSampler(40)(s, 0))
+    holed = Sample.from_depth(s.rgb, np.where(np.arange(96)[None] < 24, 0, s.depth), s.intrinsics, "half")
+    assert not KeypointSampler(40)(holed, 0)[:, :24].any()
+    plain = Sample.from_depth(np.full_like(s.rgb, 128), s.depth, s.intrinsics, "plain")
+    assert not KeypointSampler(40)(plain, 0).any()
+
+
+def test_holes_keep_the_depth_but_not_occlusion_edges_and_cover_the_fraction():
+    """Two planes (2 m left, 6 m right): the pixels on both sides of the step are dropped, every kept pixel has its
+    ground-truth depth, and the blobs take `fraction` of the frame (a quantile of the field); 0: only the edge."""
+    h, w = 80, 100
+    depth = np.where(np.arange(w)[None] < 50, 2.0, 6.0).astype(np.float32).repeat(h, 0)
+    s = Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), "step")
+    only_edges = HolesSampler(0.0)(s, 0)
+    assert not only_edges[:, 49:51].any() and (only_edges[:, :49] == 2.0).all() and (only_edges[:, 51:] == 6.0).all()
+    for fraction in (0.2, 0.5):
+        out = HolesSampler(fraction)(s, 0)
+        kept = out > 0
+        np.testing.assert_array_equal(out[kept], depth[kept])
+        assert not kept[:, 49:51].any()
+        assert abs((1 - kept.mean()) - (fraction + 2 / w * (1 - fraction))) < 0.03
+    np.testing.assert_array_equal(HolesSampler(0.3)(s, 0), HolesSampler(0.3)(s, 0))
+    assert not np.array_equal(HolesSampler(0.3)(s, 0), HolesSampler(0.3)(s, 1))

@@ -9,6 +9,8 @@ Samplers:
   UniformSampler(n)     exactly n valid pixels, uniformly without replacement.
   BernoulliSampler(n)   each valid pixel kept with probability n / #valid (Ma & Karaman 2018).
   LidarSampler(...)     the scan pattern of a spinning multi-beam LiDAR (presets hdl64, hdl32, vlp32, vlp16).
+  KeypointSampler(n)    up to n valid pixels at image corners (a structure-from-motion / visual SLAM map).
+  HolesSampler(f)       every valid pixel but occlusion edges and blobs covering f of the frame (stereo, ToF).
   Noisy(sampler, noise) any sampler followed by a Noise model.
 
 `sampler_from_spec("uniform:200")` builds one from a string (CLIs, configs); grammar in its docstring.
@@ -20,6 +22,7 @@ import hashlib
 import math
 from typing import Protocol
 
+import cv2
 import numpy as np
 
 from lipjax.data.sample import Sample
@@ -83,6 +86,78 @@ class BernoulliSampler:
         n_valid = int(valid.sum())
         prob = min(1.0, self.num_points / n_valid) if n_valid else 0.0
         keep = valid & (example_rng(seed, sample.id).random(sample.shape) < prob)
+        return np.where(keep, sample.depth, 0).astype(np.float32)
+
+
+KEYPOINT_QUALITY = (1e-3, 5e-2)  # range of the corner threshold, relative to the frame's strongest corner
+KEYPOINT_MIN_DISTANCE_PX = 3.0
+
+
+@dataclasses.dataclass(frozen=True)
+class KeypointSampler:
+    """Up to `num_points` valid pixels at image corners, as a structure-from-motion or visual-SLAM map gives them:
+    clustered on texture and outlines, none on plain surfaces.
+
+    Shi-Tomasi corners of the grey image (cv2.goodFeaturesToTrack), strongest first, at least
+    KEYPOINT_MIN_DISTANCE_PX apart, on valid pixels only; the threshold (a fraction of the strongest corner's
+    response) is drawn log-uniformly in KEYPOINT_QUALITY per example. A frame with few corners gives few points.
+    """
+
+    num_points: int
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        rng = example_rng(seed, sample.id)
+        quality = float(np.exp(rng.uniform(*np.log(KEYPOINT_QUALITY))))
+        valid = sample.valid & (sample.depth > 0)
+        grey = cv2.cvtColor(np.ascontiguousarray(sample.rgb), cv2.COLOR_RGB2GRAY)
+        corners = cv2.goodFeaturesToTrack(grey, maxCorners=self.num_points, qualityLevel=quality,
+                                          minDistance=KEYPOINT_MIN_DISTANCE_PX, mask=valid.astype(np.uint8))
+        out = np.zeros(sample.shape, np.float32)
+        if corners is not None and self.num_points > 0:
+            cols, rows = np.round(corners.reshape(-1, 2)).astype(np.int64).T
+            out[rows, cols] = np.where(valid[rows, cols], sample.depth[rows, cols], 0)
+        return out
+
+
+HOLE_EDGE = 0.05  # log-depth step between neighbours that makes an occlusion edge (5 %)
+HOLE_BLOB_CELLS = (4, 12)  # cells along the longer side of the coarse random field whose low values become holes
+
+
+@dataclasses.dataclass(frozen=True)
+class HolesSampler:
+    """Dense depth with holes, as a stereo or time-of-flight camera gives it: every valid pixel except
+
+    - both sides of every occlusion edge (|log D(p) - log D(q)| > HOLE_EDGE for 4-neighbours p, q): stereo finds
+      no match where one view is occluded and a ToF pixel mixes the two depths;
+    - blobs over a fraction `fraction` of the frame (low texture, dark or specular surfaces, out of range): a
+      smooth random field, uniform noise on a coarse grid of square cells (HOLE_BLOB_CELLS along the longer
+      side) bicubically enlarged, is below its `fraction` quantile there.
+    """
+
+    fraction: float
+
+    def __post_init__(self):
+        if not 0 <= self.fraction < 1:
+            raise ValueError(f"holes fraction must be in [0, 1), got {self.fraction}")
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        rng = example_rng(seed, sample.id)
+        h, w = sample.shape
+        valid = sample.valid & (sample.depth > 0)
+        log_d = np.log(np.where(valid, sample.depth, 1.0))
+        edge_y = valid[:-1] & valid[1:] & (np.abs(np.diff(log_d, axis=0)) > HOLE_EDGE)
+        edge_x = valid[:, :-1] & valid[:, 1:] & (np.abs(np.diff(log_d, axis=1)) > HOLE_EDGE)
+        keep = valid.copy()
+        keep[:-1] &= ~edge_y
+        keep[1:] &= ~edge_y
+        keep[:, :-1] &= ~edge_x
+        keep[:, 1:] &= ~edge_x
+        if self.fraction > 0:
+            n = int(rng.integers(HOLE_BLOB_CELLS[0], HOLE_BLOB_CELLS[1] + 1))  # along the longer side
+            cells = (max(2, round(n * h / max(h, w))), max(2, round(n * w / max(h, w))))
+            field = cv2.resize(rng.uniform(0, 1, cells).astype(np.float32), (w, h),
+                               interpolation=cv2.INTER_CUBIC)
+            keep &= field >= np.quantile(field, self.fraction)
         return np.where(keep, sample.depth, 0).astype(np.float32)
 
 
@@ -335,19 +410,28 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
       bernoulli:N                     BernoulliSampler(N)
       lidar:PRESET[,key=value...]     LidarSampler.PRESET(key=value), PRESET in hdl64 hdl32 vlp32 vlp16,
                                       keys: any float field, e.g. azimuth_step_deg=0.4,mount_pitch_deg=-2
+      keypoint:N                      KeypointSampler(N)
+      holes:F                         HolesSampler(F), F in [0, 1)
     and noise OPTIONS std=<m>,rel=<fraction>,outliers=<fraction>.
-    Examples: "uniform:200", "bernoulli:500", "lidar:vlp16", "lidar:hdl64+noise:std=0.02,outliers=0.01".
+    Examples: "uniform:200", "bernoulli:500", "lidar:vlp16", "lidar:hdl64+noise:std=0.02,outliers=0.01",
+    "keypoint:500", "holes:0.3".
     """
     base, _, noise_text = spec.strip().partition("+")
     kind, _, arg = base.partition(":")
     kind = kind.strip().lower()
     sampler: SparseSampler
-    if kind in ("uniform", "bernoulli"):
+    if kind in ("uniform", "bernoulli", "keypoint"):
         try:
             n = int(arg)
         except ValueError:
             raise ValueError(f"sampler spec {spec!r}: {kind} needs an integer point count, e.g. '{kind}:200'") from None
-        sampler = UniformSampler(n) if kind == "uniform" else BernoulliSampler(n)
+        sampler = {"uniform": UniformSampler, "bernoulli": BernoulliSampler, "keypoint": KeypointSampler}[kind](n)
+    elif kind == "holes":
+        try:
+            sampler = HolesSampler(float(arg))
+        except ValueError:
+            raise ValueError(f"sampler spec {spec!r}: holes needs the fraction of the frame in holes, in [0, 1), "
+                             "e.g. 'holes:0.3'") from None
     elif kind == "lidar":
         preset, _, options = arg.partition(",")
         if preset not in LIDAR_PRESETS:
@@ -360,7 +444,7 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
                              f"known: {sorted(fields)}")
         sampler = LIDAR_PRESETS[preset](**overrides)
     else:
-        raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N or "
+        raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N, keypoint:N, holes:F or "
                          f"lidar:{'|'.join(LIDAR_PRESETS)}")
     if noise_text:
         name, _, options = noise_text.partition(":")
