@@ -214,7 +214,8 @@ def test_sampler_from_spec():
     assert sampler_from_spec("keypoint:500") == KeypointSampler(500)
     assert sampler_from_spec("holes:0.3") == HolesSampler(0.3)
     for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1",
-                "uniform:3+blur:1", "holes:1.5", "holes:x", "keypoint:many"):
+                "uniform:3+blur:1", "holes:1.5", "holes:x", "keypoint:many",
+                "keypoint:-1"):
         with pytest.raises(ValueError):
             sampler_from_spec(bad)
 

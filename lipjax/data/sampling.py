@@ -105,6 +105,10 @@ class KeypointSampler:
 
     num_points: int
 
+    def __post_init__(self):
+        if self.num_points < 0:
+            raise ValueError(f"num_points must be >= 0, got {self.num_points}")
+
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
         rng = example_rng(seed, sample.id)
         quality = float(np.exp(rng.uniform(*np.log(KEYPOINT_QUALITY))))
@@ -113,7 +117,7 @@ class KeypointSampler:
         corners = cv2.goodFeaturesToTrack(grey, maxCorners=self.num_points, qualityLevel=quality,
                                           minDistance=KEYPOINT_MIN_DISTANCE_PX, mask=valid.astype(np.uint8))
         out = np.zeros(sample.shape, np.float32)
-        if corners is not None and self.num_points > 0:
+        if corners is not None and self.num_points > 0:  # maxCorners=0 means no limit to OpenCV
             cols, rows = np.round(corners.reshape(-1, 2)).astype(np.int64).T
             out[rows, cols] = np.where(valid[rows, cols], sample.depth[rows, cols], 0)
         return out
