@@ -15,7 +15,7 @@ class, from the ground truth and the photograph at native size:
     colour only   within NEAR_PX of a pixel with |grad I| > COLOUR_EDGE, and no depth edge near
     flat          the rest
 
-(I: the grey image in [0, 1] after a Gaussian blur of BLUR_PX; thresholds as in benchmarks/edge_statistics.py.)
+(I: the grey image in [0, 1] after a Gaussian blur; gradient and thresholds from benchmarks/edge_statistics.py.)
 Per class it prints the change of the squared-error sum against linear as a share of linear's total,
 
     model - linear     sum_class(e_model^2 - e_linear^2) / sum_all(e_linear^2)
@@ -35,6 +35,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, _gradients  # noqa: E402
 from benchmarks.real_frames import GREY, frames_and_inputs  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
@@ -42,9 +43,6 @@ from lipjax.inference import complete_frame  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 NEAR_PX = 3  # pixels at native size
-BLUR_PX = 1.0
-COLOUR_EDGE = 0.04  # grey-level change per pixel (full scale 1)
-DEPTH_EDGE = 0.05  # log-depth change per pixel
 CLASSES = ("depth edge", "colour only", "flat")
 
 
@@ -54,14 +52,13 @@ def _near(mask: np.ndarray) -> np.ndarray:
 
 def pixel_classes(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """Per pixel 0 (depth edge), 1 (colour only) or 2 (flat), as the module docstring defines them."""
-    grey = cv2.GaussianBlur(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float32) / 255.0, (0, 0), BLUR_PX)
-    gy, gx = np.gradient(grey)
     ok = valid & (depth > 0)
+    colour_gradient = _gradients(rgb, np.where(ok, depth, 0))[0]
     log_d = np.log(np.where(ok, depth, 1.0))
     step = np.zeros(depth.shape, np.float32)  # |central difference of log D| along x or y, where both ends are valid
     step[:, 1:-1] = np.where(ok[:, :-2] & ok[:, 2:], np.abs(log_d[:, 2:] - log_d[:, :-2]) / 2, 0)
     step[1:-1, :] = np.maximum(step[1:-1, :], np.where(ok[:-2] & ok[2:], np.abs(log_d[2:] - log_d[:-2]) / 2, 0))
-    depth_near, colour_near = _near(step > DEPTH_EDGE), _near(np.hypot(gx, gy) > COLOUR_EDGE)
+    depth_near, colour_near = _near(step > DEPTH_EDGE), _near(colour_gradient > COLOUR_EDGE)
     return np.where(depth_near, 0, np.where(colour_near, 1, 2))
 
 

@@ -118,8 +118,8 @@ class KeypointSampler:
                                           minDistance=KEYPOINT_MIN_DISTANCE_PX, mask=valid.astype(np.uint8))
         out = np.zeros(sample.shape, np.float32)
         if corners is not None and self.num_points > 0:  # maxCorners=0 means no limit to OpenCV
-            cols, rows = np.round(corners.reshape(-1, 2)).astype(np.int64).T
-            out[rows, cols] = np.where(valid[rows, cols], sample.depth[rows, cols], 0)
+            cols, rows = np.round(corners.reshape(-1, 2)).astype(np.int64).T  # whole pixels, inside the mask
+            out[rows, cols] = sample.depth[rows, cols]
         return out
 
 
