@@ -122,6 +122,26 @@ def test_texture_paints_the_rgb_of_a_rectangle_and_nothing_else():
     np.testing.assert_array_equal(plain.rgb, off.rgb)
 
 
+def test_texture_patches_paint_up_to_that_many_rectangles_and_one_keeps_the_old_stream():
+    """texture_patches=N paints 1..N rectangles (N=1: exactly the draws of before, so resumed runs stay exact):
+    on a grey frame more of the RGB changes on average, by at most the strength per patch, and depth never does."""
+    b = _batch(n=8)
+    grey = dataclasses.replace(b, rgb=np.full_like(b.rgb, 128))
+    aug = dataclasses.replace(DEFAULT_TRAINING, texture_prob=1.0, texture_strength=0.3, brightness=0.0, contrast=0.0,
+                              saturation=0.0, gamma=0.0, blur_prob=0.0)
+    one = augment_batch(grey, aug, (24, 32), seed=2, step=3)
+    np.testing.assert_array_equal(one.rgb, augment_batch(grey, dataclasses.replace(aug, texture_patches=1), (24, 32),
+                                                         seed=2, step=3).rgb)
+    many = augment_batch(grey, dataclasses.replace(aug, texture_patches=6), (24, 32), seed=2, step=3)
+    for name in ("gt", "sparse", "gt_valid"):
+        np.testing.assert_array_equal(getattr(one, name), getattr(many, name))
+    changed = lambda x: np.mean(np.any(x.rgb != 128, axis=-1))  # noqa: E731
+    assert changed(many) > changed(one) + 0.1
+    assert np.abs(many.rgb.astype(float) - 128).max() <= 128 * (1.3 ** 6 - 1) + 0.5
+    with pytest.raises(ValueError, match="texture_patches"):
+        dataclasses.replace(aug, texture_patches=0)
+
+
 def test_camera_noise_statistics_and_jpeg():
     """Noise of std U(0, a) * 255 per pixel: on a mid-grey frame the residual's std is below a * 255 and its mean is
     0; a JPEG round trip alone changes a textured frame by a few grey levels and leaves a flat one as it was; off:

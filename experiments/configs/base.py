@@ -64,7 +64,8 @@ MIXED_SAMPLER = "|".join((
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
     augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.5, 1.6), texture_prob=0.8, texture_strength=0.7,
-                                sensor_noise=0.02, jpeg_prob=0.3, illumination_prob=0.5, illumination_strength=0.7),
+                                texture_patches=6, sensor_noise=0.02, jpeg_prob=0.3, illumination_prob=0.5,
+                                illumination_strength=0.7),
 )
 
 # z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest
