@@ -2,12 +2,14 @@
 
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
-    python benchmarks/failure_look.py [--synthetic 8] [--realdata ../shared/realdata] [--plot PNG] [--json OUT]
+    python benchmarks/failure_look.py [--model NAME] [--synthetic 8] [--realdata ../shared/realdata] [--plot PNG]
+                                      [--json OUT]
 
 Every frame is completed at its native size through the default path (`get_completer(None, sparse)`,
-`complete_frame`), once with its photograph and once with a uniform grey image, and by `linear`. Inputs are those
-of benchmarks/real_frames.py: 200 uniform points indoors, the HDL-64 pattern on KITTI; the synthetic test renders
-get the same (rooms 256x320 with 200 points, streets 352x1216 with HDL-64). Each unsampled valid pixel falls in one
+`complete_frame`; `--model` puts one model, a name or a path, through the same path), once with its photograph
+and once with a uniform grey image, and by `linear`. Inputs are those of benchmarks/real_frames.py: 200 uniform
+points indoors, the HDL-64 pattern on KITTI; the synthetic test renders get the same (rooms 256x320 with 200
+points, streets 352x1216 with HDL-64). Each unsampled valid pixel falls in one
 class, from the ground truth and the photograph at native size:
 
     depth edge    within NEAR_PX of a pixel where |d log D| > DEPTH_EDGE along x or y (central differences
@@ -62,8 +64,9 @@ def pixel_classes(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> np.n
     return np.where(depth_near, 0, np.where(colour_near, 1, 2))
 
 
-def frame_row(name: str, input_name: str, rgb, depth, valid, sparse, linear) -> tuple[dict, np.ndarray]:
-    completer = get_completer(None, sparse=sparse)
+def frame_row(name: str, input_name: str, rgb, depth, valid, sparse, linear,
+              model: str | None = None) -> tuple[dict, np.ndarray]:
+    completer = get_completer(model, sparse=sparse)
     keep = valid & (sparse <= 0) & (depth > 0)
     e_lin = np.where(keep, linear(rgb, sparse) - depth, 0.0)
     e_rgb = np.where(keep, complete_frame(completer, rgb, sparse) - depth, 0.0)
@@ -126,6 +129,7 @@ def plot(worst: list[tuple[dict, np.ndarray, np.ndarray, np.ndarray]], path: str
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--synthetic", type=int, default=8, help="synthetic test frames per kind")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
     ap.add_argument("--plot", default=None, help="write the worst frames' error maps here (PNG)")
@@ -137,11 +141,11 @@ def main(argv=None) -> None:
     for group, s, sparse, input_name in frames_and_inputs(os.path.abspath(args.realdata)):
         if group == "kitti-30pct":
             continue
-        row, gain = frame_row(s.id, input_name, s.rgb, s.depth, s.valid, sparse, linear)
+        row, gain = frame_row(s.id, input_name, s.rgb, s.depth, s.valid, sparse, linear, args.model)
         real.append(row)
         pictures.append((row, s.rgb, np.where(s.valid, s.depth, 0), gain))
         print(f"{s.id:30s} {row['ratio']:.3f}", flush=True)
-    synthetic = [frame_row(f"{kind} {s.id}", input_name, s.rgb, s.depth, s.valid, sparse, linear)[0]
+    synthetic = [frame_row(f"{kind} {s.id}", input_name, s.rgb, s.depth, s.valid, sparse, linear, args.model)[0]
                  for kind, s, sparse, input_name in synthetic_frames(args.synthetic)]
     print_table("Shared real frames (native size, default path)", real)
     for kind in ("rooms", "streets"):
