@@ -87,12 +87,13 @@ def test_outdoor_sky_is_invalid_and_depth_within_range():
         assert 1.4 <= info.camera_height_m <= 1.9
 
 
-def _ground_check(kind: str, label: str, split: str, index: int, height: int, width: int):
+def _ground_check(kind: str, label: str, split: str, index: int, height: int, width: int,
+                  focal_range=(1.0, 1.0)):
     """Depth of every `label` pixel (a point of the plane y = 0) against the analytic z-depth of that plane.
 
     Pixel (u, v) looks along d = K^-1 (u, v, 1) in the camera frame (z component 1); its ray meets the plane
     y_world = 0 at t = -c_y / (R d)_y, and because d_z = 1, t is the z-depth."""
-    s, info = S.render_with_info(kind, split, index, height, width)
+    s, info = S.render_with_info(kind, split, index, height, width, focal_range)
     on_plane = info.labels == S.LABELS.index(label)
     k = s.intrinsics
     R, c = info.camera_to_world[:3, :3], info.camera_to_world[:3, 3]
@@ -124,6 +125,32 @@ def test_indoor_floor_depth_is_the_analytic_z_depth(index):
 
 def test_outdoor_road_depth_is_the_analytic_z_depth():
     _ground_check("outdoor", "road", "val", 0, 60, 80)
+
+
+@pytest.mark.parametrize("kind, label, factor", [("indoor", "floor", 0.6), ("outdoor", "road", 1.5)])
+def test_a_focal_factor_scales_the_camera_and_the_depth_follows_it(kind, label, factor):
+    """focal_range (f, f): the frame's focal lengths are f times the reference, its principal point and pose the
+    same, and its floor / road depth is the plane's analytic z-depth through the scaled camera."""
+    ref, ref_info = S.render_with_info(kind, "val", 0, 60, 80)
+    s, info = _ground_check(kind, label, "val", 0, 60, 80, focal_range=(factor, factor))
+    k, k0 = s.intrinsics, ref.intrinsics
+    assert (k.fx, k.fy, k.cx, k.cy) == pytest.approx((factor * k0.fx, factor * k0.fy, k0.cx, k0.cy))
+    np.testing.assert_array_equal(info.camera_to_world, ref_info.camera_to_world)
+    assert not np.array_equal(s.depth, ref.depth)
+
+
+def test_focal_factors_are_drawn_per_frame_within_the_range_and_reproducibly():
+    factors = [S.focal_factor("indoor", "train", i, (0.7, 1.4)) for i in range(200)]
+    assert 0.7 <= min(factors) and max(factors) <= 1.4
+    assert np.mean(np.log(factors)) == pytest.approx(np.log(0.7 * 1.4) / 2, abs=0.03)  # log-uniform: centred
+    assert factors == [S.focal_factor("indoor", "train", i, (0.7, 1.4)) for i in range(200)]
+    assert S.focal_factor("indoor", "train", 3) == 1.0
+    data = S.SyntheticDataset("indoor", "train", size=2, height=24, width=32, focal_range=(0.7, 1.4))
+    assert data[1].intrinsics.fx == pytest.approx(S.intrinsics_for("indoor", 24, 32).fx * factors[1])
+    assert "focal_range=(0.7, 1.4)" in repr(data)
+    for bad in [(0.0, 1.0), (1.2, 1.1), 1.0, ("a", 1)]:
+        with pytest.raises(ValueError, match="focal_range"):
+            S.SyntheticDataset("indoor", "train", focal_range=bad)
 
 
 @pytest.mark.parametrize("kind", S.SYNTHETIC_KINDS)

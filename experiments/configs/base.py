@@ -61,11 +61,15 @@ MIXED_SAMPLER = "|".join((
 # Zoom 0.5 shows whole 256x320 frames at half scale (KITTI-size streets at their working size); texture and camera
 # noise against the renders' clean, flat surfaces, and light that follows no geometry (docs/design-notes.md, "RGB
 # guidance from renders to photographs").
+# Focal lengths 0.7-1.4x the reference camera's (per training frame): rooms seen at 48-83 deg across (NYU v2: 63),
+# KITTI-wide streets at 63-102 (KITTI: 81), as phones, RGB-D cameras and robot cameras differ.
+MIXED_FOCAL_RANGE = (0.7, 1.4)
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
     augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.5, 1.6), texture_prob=0.8, texture_strength=0.7,
                                 texture_patches=6, sensor_noise=0.02, jpeg_prob=0.3, illumination_prob=0.5,
                                 illumination_strength=0.7),
+    focal_range=MIXED_FOCAL_RANGE,
 )
 
 # z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest

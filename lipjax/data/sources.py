@@ -145,9 +145,10 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         from lipjax.data.synthetic.dataset import MixedSyntheticDataset, SyntheticDataset
 
         size = data.val_images if split == "val" else None
+        focal = (1.0, 1.0) if split == "val" else data.focal_range  # validation: the reference camera
         if data.kind == MIXED_SCENES:
-            return MixedSyntheticDataset(split, size=size, height=data.height, width=data.width), None
-        return SyntheticDataset(data.kind, split, size=size, height=data.height, width=data.width), None
+            return MixedSyntheticDataset(split, size, data.height, data.width, focal), None
+        return SyntheticDataset(data.kind, split, size, data.height, data.width, focal), None
     if root is None:
         raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")
     if source == "rendered":

@@ -31,6 +31,9 @@ class DataConfig:
     val_images: the validation set is the first val_images val frames (None: all of them).
     num_workers: loader worker processes (0: load in the training process).
     augment: training augmentation applied with the crop (zoom, flip, photometric, blur, sample noise).
+    focal_range: source synthetic, training frames only: (lo, hi) factors on the reference camera's focal
+    length, one drawn per frame (lipjax.data.synthetic.focal_factor): fields of view wider and narrower than
+    NYU v2's and KITTI's. Validation keeps the reference camera, so that runs stay comparable.
     """
 
     kind: str = "indoor"
@@ -47,6 +50,7 @@ class DataConfig:
     protocol: str | None = None
     depth_scale: float | None = None
     augment: Augment = Augment()  # lipjax.data.augment; the default only crops
+    focal_range: tuple[float, float] = (1.0, 1.0)
 
 
 LOSS_SCALES = ("max_depth", "samples")

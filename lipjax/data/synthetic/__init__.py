@@ -30,7 +30,9 @@ highlight shoulder and gamma 2.0-2.4, 8-bit quantisation.
 
 Camera intrinsics: `intrinsics_for(kind, H, W)` scales the reference camera to the render size with
 square pixels (largest centred crop of the reference frame with the render's aspect ratio, then an
-isotropic resize); see its docstring.
+isotropic resize); see its docstring. `focal_range=(lo, hi)` (render, SyntheticDataset) multiplies its focal
+lengths by a factor drawn per frame (`focal_factor`, log-uniform): wider and narrower fields of view of the same
+scene from the same pose.
 
 Conventions:
   * Camera frame: x right, y down, z forward (OpenCV). Pixel (row v, column u) has its centre at (u, v);
@@ -61,10 +63,10 @@ Per-primitive numpy calls are batched where the arithmetic allows it without cha
 (small parts' camera rays, box and cylinder surfaces, shadow rays: one call per primitive kind); textures
 (one call per material) and scene construction (Python) remain per object.
 
-Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`, `SceneInfo`,
-`LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window of the camera)
-its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`), `render_scene` (the
-scene through a camera), `check_kind_split`, `check_size`.
+Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `focal_factor`, `sample_id`,
+`SceneInfo`, `LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window
+of the camera) its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`),
+`render_scene` (the scene through a camera), `check_kind_split`, `check_size`, `check_focal_range`.
 
 Modules, each importing only those before it: `constants`; `arrays`, `noise`, `colour` (numpy helpers, procedural
 noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (intersection kernels, primitives);
@@ -95,8 +97,10 @@ from lipjax.data.synthetic.constants import (
 from lipjax.data.synthetic.dataset import (
     SceneInfo,
     SyntheticDataset,
+    check_focal_range,
     check_kind_split,
     check_size,
+    focal_factor,
     frame_rngs,
     intrinsics_for,
     render,
@@ -127,8 +131,10 @@ __all__ = [
     "SceneInfo",
     "SyntheticDataset",
     "build_scene",
+    "check_focal_range",
     "check_kind_split",
     "check_size",
+    "focal_factor",
     "frame_rngs",
     "intrinsics_for",
     "render",

@@ -97,6 +97,30 @@ def sample_id(kind: str, split: str, index: int) -> str:
     return f"synthetic/{kind}/{split}/{index:06d}"
 
 
+def focal_factor(kind: str, split: str, index: int, focal_range: tuple[float, float] = (1.0, 1.0)) -> float:
+    """The factor on the reference camera's focal length for frame `index`: log-uniform in `focal_range`
+    (lo, hi), drawn from a stream of its own (sha256 of "lipjax/synthetic/focal/v1/{kind}/{split}/{index}"), so the
+    scene and the sensor noise are those of the same frame at the reference focal length. 1 for (1, 1)."""
+    lo, hi = check_focal_range(focal_range)
+    if lo == hi:
+        return lo
+    digest = hashlib.sha256(f"lipjax/synthetic/focal/v1/{kind}/{split}/{index}".encode("utf-8")).digest()
+    u = np.random.default_rng(int.from_bytes(digest[:16], "little")).random()
+    return float(np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo))))
+
+
+def check_focal_range(focal_range) -> tuple[float, float]:
+    """(lo, hi) as floats; ValueError unless 0 < lo <= hi."""
+    try:
+        lo, hi = (float(v) for v in focal_range)
+    except (TypeError, ValueError):
+        raise ValueError(f"focal_range must be (lo, hi), two factors on the focal length, got {focal_range!r}"
+                         ) from None
+    if not 0 < lo <= hi:
+        raise ValueError(f"focal_range must have 0 < lo <= hi, got {focal_range!r}")
+    return lo, hi
+
+
 def frame_rngs(kind: str, split: str, index: int) -> tuple[np.random.Generator, np.random.Generator]:
     """(scene stream, sensor-noise stream) of frame `index` of (kind, split): two numpy Generators spawned from
     sha256("lipjax/synthetic/v1/{kind}/{split}/{index}"), the same in every process."""
@@ -108,9 +132,13 @@ def frame_rngs(kind: str, split: str, index: int) -> tuple[np.random.Generator, 
 
 
 def render_with_info(
-    kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH
+    kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
+    focal_range: tuple[float, float] = (1.0, 1.0),
 ) -> tuple[Sample, SceneInfo]:
     """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
+
+    `focal_range`: the camera's focal lengths are intrinsics_for(kind, H, W)'s times `focal_factor` (principal
+    point kept): below 1 a wider field of view, above 1 a narrower one, the same scene and pose.
 
     Raises:
       ValueError: unknown kind / split, a negative or non-integer index, or a size below 8 pixels.
@@ -121,6 +149,9 @@ def render_with_info(
     scene_rng, noise_rng = frame_rngs(kind, split, index)
     scene = build_scene(kind, scene_rng)
     intr = intrinsics_for(kind, height, width)
+    f = focal_factor(kind, split, index, focal_range)
+    if f != 1.0:
+        intr = dataclasses.replace(intr, fx=intr.fx * f, fy=intr.fy * f)
     with np.errstate(all="ignore"):
         rgb, depth, labels = render_scene(scene, height, width, intr, noise_rng)
     sample = Sample.from_depth(rgb, depth, intr, sample_id(kind, split, index))
@@ -130,7 +161,8 @@ def render_with_info(
     return sample, SceneInfo(kind, pose, float(scene.cam_pos[1]), labels)
 
 
-def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH) -> Sample:
+def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
+           focal_range: tuple[float, float] = (1.0, 1.0)) -> Sample:
     """Renders frame `index` of the synthetic (kind, split) set as a Sample.
 
     Args:
@@ -138,12 +170,13 @@ def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, widt
       split: "train", "val" or "test" (disjoint scenes).
       index: >= 0. Any non-negative int is a valid scene; `SyntheticDataset` bounds it by its size.
       height, width: render size in pixels (the scene does not depend on it).
+      focal_range: (lo, hi) factors on the focal length, one drawn per frame (`render_with_info`).
     Returns:
       Sample with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
       than RENDER_FAR_CLIP_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W),
       id = "synthetic/{kind}/{split}/{index:06d}".
     """
-    return render_with_info(kind, split, index, height, width)[0]
+    return render_with_info(kind, split, index, height, width, focal_range)[0]
 
 
 class _IndexOutOfRange(ValueError, IndexError):
@@ -158,10 +191,12 @@ class SyntheticDataset:
       split: "train", "val" or "test".
       size: number of frames; None = DEFAULT_SIZES[split] (train 100000, val 200, test 200).
       height, width: render size in pixels.
+      focal_range: (lo, hi) factors on the reference focal length, one per frame (`focal_factor`); (1, 1): the
+        reference camera (NYU v2 / KITTI).
     """
 
     def __init__(self, kind: str, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT,
-                 width: int = DEFAULT_WIDTH):
+                 width: int = DEFAULT_WIDTH, focal_range: tuple[float, float] = (1.0, 1.0)):
         check_kind_split(kind, split)
         if size is None:
             size = DEFAULT_SIZES[split]
@@ -169,6 +204,7 @@ class SyntheticDataset:
             raise ValueError(f"size must be a non-negative int or None, got {size!r}")
         self.kind, self.split, self.size = kind, split, int(size)
         self.height, self.width = check_size(height, width)
+        self.focal_range = check_focal_range(focal_range)
 
     def __len__(self) -> int:
         return self.size
@@ -178,19 +214,21 @@ class SyntheticDataset:
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
                                    f"of size {self.size}")
-        return render(self.kind, self.split, index, self.height, self.width)
+        return render(self.kind, self.split, index, self.height, self.width, self.focal_range)
 
     def __iter__(self) -> Iterator[Sample]:
         for i in range(self.size):
-            yield render(self.kind, self.split, i, self.height, self.width)
+            yield self[i]
 
     @property
     def intrinsics(self) -> Intrinsics:
+        """The reference camera at this size (a frame's own, with its focal factor, is its Sample.intrinsics)."""
         return intrinsics_for(self.kind, self.height, self.width)
 
     def __repr__(self) -> str:
+        focal = "" if self.focal_range == (1.0, 1.0) else f", focal_range={self.focal_range}"
         return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
-                f"width={self.width})")
+                f"width={self.width}{focal})")
 
 
 
@@ -206,8 +244,9 @@ class MixedSyntheticDataset:
 
     kind = MIXED_SCENES
 
-    def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH):
-        self.parts = tuple(SyntheticDataset(kind, split, None, height, width) for kind in SYNTHETIC_KINDS)
+    def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
+                 focal_range: tuple[float, float] = (1.0, 1.0)):
+        self.parts = tuple(SyntheticDataset(kind, split, None, height, width, focal_range) for kind in SYNTHETIC_KINDS)
         self.split, self.height, self.width = split, *check_size(height, width)
         self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
 
@@ -222,4 +261,6 @@ class MixedSyntheticDataset:
         return self.parts[index % 2][index // 2]
 
     def __repr__(self) -> str:
-        return f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width})"
+        focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
+        return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
+                f"{focal})")
