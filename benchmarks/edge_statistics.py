@@ -1,6 +1,6 @@
 """Do colour edges mark depth edges as often in the renders as in photographs? The RGB guidance's shortcut, measured.
 
-    python benchmarks/edge_statistics.py [--frames 30] [--realdata ../shared/realdata]
+    python benchmarks/edge_statistics.py [--frames 30] [--realdata ../shared/realdata] [--texture 1,3,6]
 
 A prox that learned "a colour edge is a depth edge" from the renders transfers to photographs only as far as that
 holds there. Every frame (synthetic test renders of both kinds; the shared real frames, read from ../shared/realdata,
@@ -16,6 +16,8 @@ and per frame kind it prints, over pixels where the depth gradient is defined:
     precision                P(depth edge near | colour edge): how often a colour edge is a depth edge
     recall                   P(colour edge near | depth edge): how often a depth edge shows in the image
     rank correlation         Spearman's rho of |grad I| and |grad log D|
+`--texture N,...` adds rows for the renders with 1-N textured rectangles painted as training paints them
+(lipjax.data.augment.paint_texture at strength TEXTURE_STRENGTH, exactly N per frame, seeded by the frame's index).
 The renders' numbers against the photographs' tell which shortcut the prox can learn from renders that photographs
 do not share (docs/design-notes.md, "RGB guidance from renders to photographs").
 """
@@ -32,6 +34,7 @@ from scipy.stats import spearmanr
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from benchmarks.real_frames import load_lingbot  # noqa: E402
 from benchmarks.baselines import load_kitti, load_middlebury, load_nyu  # noqa: E402
+from lipjax.data.augment import paint_texture  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
 
 SIDE_PX = 320  # every frame's longer side, pixels, before the statistics
@@ -39,6 +42,7 @@ BLUR_PX = 1.0  # Gaussian blur of the grey image, pixels
 COLOUR_EDGE = 0.04  # grey-level change per pixel (of full scale 1) that counts as a colour edge
 DEPTH_EDGE = 0.05  # log-depth change per pixel (5 %) that counts as a depth edge
 NEAR_PX = 1
+TEXTURE_STRENGTH = 0.7  # lip_any's texture_strength (experiments/configs/base.py)
 
 
 def _resized(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray):
@@ -86,6 +90,17 @@ def _renders(kind: str, frames: int):
         yield s.rgb, s.depth, s.valid
 
 
+def _textured(frames: list, patches: int) -> list:
+    """The frames with `patches` textured rectangles painted on their RGB, depth untouched."""
+    out = []
+    for i, (rgb, depth, valid) in enumerate(frames):
+        rng = np.random.default_rng(i)
+        for _ in range(patches):
+            rgb = paint_texture(rgb, TEXTURE_STRENGTH, rng)
+        out.append((rgb, depth, valid))
+    return out
+
+
 def _real(root: str):
     groups = {"NYU v2": load_nyu(os.path.join(root, "nyu_v2")),
               "Middlebury": load_middlebury(os.path.join(root, "middlebury2014_motorcycle")),
@@ -98,9 +113,14 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=30, help="synthetic test frames per kind")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--texture", default="", help="comma-separated patch counts: also the textured renders")
     args = ap.parse_args(argv)
-    sources = {"renders, rooms": list(_renders("indoor", args.frames)),
-               "renders, streets": list(_renders("outdoor", args.frames)), **_real(os.path.abspath(args.realdata))}
+    rooms, streets = list(_renders("indoor", args.frames)), list(_renders("outdoor", args.frames))
+    sources = {"renders, rooms": rooms, "renders, streets": streets}
+    for n in (int(t) for t in args.texture.split(",") if t):
+        sources[f"renders, rooms, {n} textured"] = _textured(rooms, n)
+        sources[f"renders, streets, {n} textured"] = _textured(streets, n)
+    sources.update(_real(os.path.abspath(args.realdata)))
     keys = ("density", "precision", "recall", "rho")
     print(f"| frames | n | colour edge density | P(depth edge | colour edge) | P(colour edge | depth edge) | "
           f"Spearman rho |\n|---|---|---|---|---|---|")
