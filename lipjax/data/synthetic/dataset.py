@@ -173,8 +173,8 @@ def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, widt
       focal_range: (lo, hi) factors on the focal length, one drawn per frame (`render_with_info`).
     Returns:
       Sample with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
-      than RENDER_FAR_CLIP_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W),
-      id = "synthetic/{kind}/{split}/{index:06d}".
+      than RENDER_FAR_CLIP_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W) (focal lengths times
+      the frame's `focal_factor`), id = "synthetic/{kind}/{split}/{index:06d}".
     """
     return render_with_info(kind, split, index, height, width, focal_range)[0]
 
