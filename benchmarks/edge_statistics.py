@@ -53,7 +53,7 @@ def _resized(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray):
             cv2.resize(np.where(valid, depth, 0).astype(np.float32), size, interpolation=cv2.INTER_NEAREST))
 
 
-def _gradients(rgb: np.ndarray, depth: np.ndarray):
+def gradients(rgb: np.ndarray, depth: np.ndarray):
     """(|grad I|, |grad log D|, defined) per pixel, central differences, interior pixels only."""
     grey = cv2.GaussianBlur(cv2.cvtColor(rgb, cv2.COLOR_RGB2GRAY).astype(np.float32) / 255.0, (0, 0), BLUR_PX)
     gy, gx = np.gradient(grey)
@@ -68,7 +68,7 @@ def _gradients(rgb: np.ndarray, depth: np.ndarray):
 
 
 def frame_statistics(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> dict | None:
-    g_i, g_d, defined = _gradients(*_resized(rgb, depth, valid))
+    g_i, g_d, defined = gradients(*_resized(rgb, depth, valid))
     if defined.sum() < 100:
         return None
     kernel = np.ones((2 * NEAR_PX + 1,) * 2, np.uint8)

@@ -37,7 +37,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, _gradients  # noqa: E402
+from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, gradients  # noqa: E402
 from benchmarks.real_frames import GREY, frames_and_inputs  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
@@ -55,7 +55,7 @@ def _near(mask: np.ndarray) -> np.ndarray:
 def pixel_classes(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """Per pixel 0 (depth edge), 1 (colour only) or 2 (flat), as the module docstring defines them."""
     ok = valid & (depth > 0)
-    colour_gradient = _gradients(rgb, np.where(ok, depth, 0))[0]
+    colour_gradient = gradients(rgb, np.where(ok, depth, 0))[0]
     log_d = np.log(np.where(ok, depth, 1.0))
     step = np.zeros(depth.shape, np.float32)  # |central difference of log D| along x or y, where both ends are valid
     step[:, 1:-1] = np.where(ok[:, :-2] & ok[:, 2:], np.abs(log_d[:, 2:] - log_d[:, :-2]) / 2, 0)

@@ -97,6 +97,11 @@ def sample_id(kind: str, split: str, index: int) -> str:
     return f"synthetic/{kind}/{split}/{index:06d}"
 
 
+def _seed(name: str) -> int:
+    """A 128-bit seed from a stream's name: the first 16 bytes of sha256(name), little-endian."""
+    return int.from_bytes(hashlib.sha256(name.encode("utf-8")).digest()[:16], "little")
+
+
 def focal_factor(kind: str, split: str, index: int, focal_range: tuple[float, float] = (1.0, 1.0)) -> float:
     """The factor on the reference camera's focal length for frame `index`: log-uniform in `focal_range`
     (lo, hi), drawn from a stream of its own (sha256 of "lipjax/synthetic/focal/v1/{kind}/{split}/{index}"), so the
@@ -104,8 +109,7 @@ def focal_factor(kind: str, split: str, index: int, focal_range: tuple[float, fl
     lo, hi = check_focal_range(focal_range)
     if lo == hi:
         return lo
-    digest = hashlib.sha256(f"lipjax/synthetic/focal/v1/{kind}/{split}/{index}".encode("utf-8")).digest()
-    u = np.random.default_rng(int.from_bytes(digest[:16], "little")).random()
+    u = np.random.default_rng(_seed(f"lipjax/synthetic/focal/v1/{kind}/{split}/{index}")).random()
     return float(np.exp(np.log(lo) + u * (np.log(hi) - np.log(lo))))
 
 
@@ -124,8 +128,7 @@ def check_focal_range(focal_range) -> tuple[float, float]:
 def frame_rngs(kind: str, split: str, index: int) -> tuple[np.random.Generator, np.random.Generator]:
     """(scene stream, sensor-noise stream) of frame `index` of (kind, split): two numpy Generators spawned from
     sha256("lipjax/synthetic/v1/{kind}/{split}/{index}"), the same in every process."""
-    digest = hashlib.sha256(f"lipjax/synthetic/v1/{kind}/{split}/{index}".encode("utf-8")).digest()
-    seed = int.from_bytes(digest[:16], "little")
+    seed = _seed(f"lipjax/synthetic/v1/{kind}/{split}/{index}")
     scene_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(0,)))
     noise_rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1,)))
     return scene_rng, noise_rng
