@@ -537,3 +537,11 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
         assert cli.main(base + args) == 1, args
         lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
         assert len(lines) == 1 and lines[0].startswith(f"lipjax: error: {message}"), lines
+
+
+def test_synthetic_far_views_train_on_mixed_scenes_only_and_never_validate():
+    mixed = DataConfig(kind="mixed", height=H, width=W, far_view_prob=1.0, val_images=2)
+    assert open_source(mixed, "train").dataset.far_view_prob == 1.0
+    assert open_source(mixed, "val").dataset.far_view_prob == 0.0  # validation: closed rooms
+    with pytest.raises(ValueError, match="data.far_view_prob needs rooms and streets"):
+        open_source(DataConfig(kind="indoor", far_view_prob=0.3), "train")

@@ -240,3 +240,51 @@ def test_mixed_dataset_interleaves_rooms_and_streets():
         np.testing.assert_array_equal(got.depth, want.depth)
     with pytest.raises(IndexError):
         mixed[4]
+
+
+def test_a_far_view_replaces_one_rectangle_of_the_room_by_the_same_sized_rectangle_of_the_view():
+    """add_far_view: inside the window, rgb and depth are the view's (its invalid sky stays invalid); outside, the
+    room's; the window's size and place lie in the documented ranges; the room's id and camera are kept."""
+    from lipjax.data.synthetic import far_view as F
+
+    room, view = S.render("indoor", "val", 0, H, W), S.render("outdoor", "val", 0, H, W)
+    for seed in range(20):
+        t, l, h, w, tv, lv = F.far_view_box((H, W), np.random.default_rng(seed))
+        out = F.add_far_view(room, view, np.random.default_rng(seed))
+        inside = np.zeros((H, W), bool)
+        inside[t:t + h, l:l + w] = True
+        assert F.WINDOW_HEIGHT[0] * H - 1 <= h <= F.WINDOW_HEIGHT[1] * H + 1
+        assert F.WINDOW_WIDTH[0] * W - 1 <= w <= F.WINDOW_WIDTH[1] * W + 1
+        assert 0 <= t <= F.WINDOW_TOP[1] * H and t + h <= H and 0 <= l <= W - w
+        assert tv + h <= max(F.VIEW_ROWS * H, h) and 0 <= lv <= W - w
+        np.testing.assert_array_equal(out.depth[inside], view.depth[tv:tv + h, lv:lv + w].ravel())
+        np.testing.assert_array_equal(out.valid[inside], view.valid[tv:tv + h, lv:lv + w].ravel())
+        np.testing.assert_array_equal(out.rgb[inside], view.rgb[tv:tv + h, lv:lv + w].reshape(-1, 3))
+        np.testing.assert_array_equal(out.depth[~inside], room.depth[~inside])
+        np.testing.assert_array_equal(out.rgb[~inside], room.rgb[~inside])
+        assert out.id == room.id and out.intrinsics == room.intrinsics
+    with pytest.raises(ValueError, match="view of the room's size"):
+        F.add_far_view(room, S.render("outdoor", "val", 0, H, W + 8), np.random.default_rng(0))
+
+
+def test_mixed_rooms_get_far_views_at_the_given_rate_reproducibly_and_streets_never():
+    from lipjax.data.synthetic.dataset import MixedSyntheticDataset, far_view_rng
+
+    closed = MixedSyntheticDataset("train", size=8, height=24, width=32)
+    always = MixedSyntheticDataset("train", size=8, height=24, width=32, far_view_prob=1.0)
+    assert "far_view_prob=1.0" in repr(always) and "far_view" not in repr(closed)
+    for i in range(0, 8, 2):  # every room differs from its closed render, and only in far (street) depths
+        changed = always[i].depth != closed[i].depth
+        assert changed.any() and (always[i].depth[changed] == 0).mean() < 1
+        assert _digest(always[i]) == _digest(always[i])
+    for i in range(1, 8, 2):
+        assert _digest(always[i]) == _digest(closed[i])
+    drawn = np.mean([far_view_rng("train", i).random() < 0.3 for i in range(4000)])
+    assert abs(drawn - 0.3) < 0.03  # whether room i has a view is the first draw of its stream
+    some = MixedSyntheticDataset("train", size=8, height=24, width=32, far_view_prob=0.3)
+    for i in range(0, 8, 2):
+        has_view = far_view_rng("train", i // 2).random() < 0.3
+        assert (_digest(some[i]) != _digest(closed[i])) == has_view
+    for bad in (-0.1, 1.5, "x", None):
+        with pytest.raises(ValueError, match="far_view_prob must be a probability"):
+            MixedSyntheticDataset("train", size=2, height=24, width=32, far_view_prob=bad)

@@ -64,12 +64,15 @@ MIXED_SAMPLER = "|".join((
 # Focal lengths 0.7-1.4x the reference camera's (per training frame): rooms seen at 48-83 deg across (NYU v2: 63),
 # KITTI-wide streets at 63-102 (KITTI: 81), as phones, RGB-D cameras and robot cameras differ.
 MIXED_FOCAL_RANGE = (0.7, 1.4)
+# Rooms with a window onto a street (lipjax.data.synthetic.far_view): a closed room never shows a far sample, and the
+# prox learned to reject them (docs/design-notes.md, "Far views inside rooms").
+MIXED_FAR_VIEW_PROB = 0.3
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",
     augment=dataclasses.replace(DEFAULT_AUGMENT, zoom=(0.5, 1.6), texture_prob=0.8, texture_strength=0.7,
                                 texture_patches=6, sensor_noise=0.02, jpeg_prob=0.3, illumination_prob=0.5,
                                 illumination_strength=0.7),
-    focal_range=MIXED_FOCAL_RANGE,
+    focal_range=MIXED_FOCAL_RANGE, far_view_prob=MIXED_FAR_VIEW_PROB,
 )
 
 # z_0, the fill the learned prox starts from (an untrained model returns it): the classical fill with the lowest

@@ -34,6 +34,8 @@ class DataConfig:
     focal_range: source synthetic, training frames only: (lo, hi) factors on the reference camera's focal
     length, one drawn per frame (lipjax.data.synthetic.focal_factor): fields of view wider and narrower than
     NYU v2's and KITTI's. Validation keeps the reference camera, so that runs stay comparable.
+    far_view_prob: source synthetic, kind mixed, training frames only: the probability that a room shows a street
+    through a window (lipjax.data.synthetic.far_view): far samples inside rooms. Validation keeps closed rooms.
     """
 
     kind: str = "indoor"
@@ -51,6 +53,7 @@ class DataConfig:
     depth_scale: float | None = None
     augment: Augment = Augment()  # lipjax.data.augment; the default only crops
     focal_range: tuple[float, float] = (1.0, 1.0)
+    far_view_prob: float = 0.0
 
 
 LOSS_SCALES = ("max_depth", "samples")

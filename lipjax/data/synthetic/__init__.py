@@ -32,7 +32,8 @@ Camera intrinsics: `intrinsics_for(kind, H, W)` scales the reference camera to t
 square pixels (largest centred crop of the reference frame with the render's aspect ratio, then an
 isotropic resize); see its docstring. `focal_range=(lo, hi)` (render, SyntheticDataset) multiplies its focal
 lengths by a factor drawn per frame (`focal_factor`, log-uniform): wider and narrower fields of view of the same
-scene from the same pose.
+scene from the same pose. `MixedSyntheticDataset(..., far_view_prob=p)` opens a window onto a street in a share p of
+its rooms (`far_view.add_far_view`): a room's frame then holds depths of 1-80 m, as photographs of rooms often do.
 
 Conventions:
   * Camera frame: x right, y down, z forward (OpenCV). Pixel (row v, column u) has its centre at (u, v);
@@ -66,7 +67,8 @@ Per-primitive numpy calls are batched where the arithmetic allows it without cha
 Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `focal_factor`, `sample_id`,
 `SceneInfo`, `LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window
 of the camera) its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`),
-`render_scene` (the scene through a camera), `check_kind_split`, `check_size`, `check_focal_range`.
+`render_scene` (the scene through a camera), `check_kind_split`, `check_size`, `check_focal_range`,
+`add_far_view` (a room with a street through a window).
 
 Modules, each importing only those before it: `constants`; `arrays`, `noise`, `colour` (numpy helpers, procedural
 noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (intersection kernels, primitives);
@@ -75,7 +77,8 @@ scene elements, each a builder with its parameter ranges in a frozen dataclass: 
 `indoor` (room shell, decals, camera, furniture placement, ceiling lights); `street` (the layout), `road`,
 `vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
 `scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
-`render_scene`); `dataset` (the public entry points: seeds, checks, `render`).
+`render_scene`); `far_view` (windows onto streets in rooms); `dataset` (the public entry points: seeds,
+checks, `render`).
 """
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,
@@ -107,6 +110,7 @@ from lipjax.data.synthetic.dataset import (
     render_with_info,
     sample_id,
 )
+from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import render_scene
 from lipjax.data.synthetic.scene import Scene
 from lipjax.data.synthetic.scenes import build_scene
@@ -130,6 +134,7 @@ __all__ = [
     "Scene",
     "SceneInfo",
     "SyntheticDataset",
+    "add_far_view",
     "build_scene",
     "check_focal_range",
     "check_kind_split",

@@ -26,6 +26,7 @@ from lipjax.data.synthetic.constants import (
 )
 from lipjax.data.synthetic.renderer import render_scene
 from lipjax.data.synthetic.scenes import build_scene
+from lipjax.data.synthetic.far_view import add_far_view, check_far_view_prob
 
 
 @dataclasses.dataclass(frozen=True)
@@ -134,6 +135,12 @@ def frame_rngs(kind: str, split: str, index: int) -> tuple[np.random.Generator, 
     return scene_rng, noise_rng
 
 
+def far_view_rng(split: str, index: int) -> np.random.Generator:
+    """The stream that decides room `index` of `split`'s window (MixedSyntheticDataset): whether, which view,
+    where; sha256 of "lipjax/synthetic/window/v1/{split}/{index}"."""
+    return np.random.default_rng(_seed(f"lipjax/synthetic/window/v1/{split}/{index}"))
+
+
 def render_with_info(
     kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
     focal_range: tuple[float, float] = (1.0, 1.0),
@@ -234,8 +241,6 @@ class SyntheticDataset:
                 f"width={self.width}{focal})")
 
 
-
-
 class MixedSyntheticDataset:
     """Rooms and streets interleaved, for one model of both: dataset[2 i] == render("indoor", split, i, H, W),
     dataset[2 i + 1] == render("outdoor", split, i, H, W).
@@ -243,15 +248,20 @@ class MixedSyntheticDataset:
     Both kinds are rendered at the same height x width (so that they batch together); the outdoor camera keeps
     KITTI's vertical field of view (`intrinsics_for`). Sample ids are the per-kind ones, so a sampler draws the same
     points from a frame here as from the single-kind set.
+
+    far_view_prob: the probability that a room shows a far view through a window (lipjax.data.synthetic.far_view):
+    with it, room i gets a rectangle of street frame j of the same split, j and the rectangle drawn from
+    `far_view_rng(split, i)`. 0: closed rooms, as `render` gives them.
     """
 
     kind = MIXED_SCENES
 
     def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
-                 focal_range: tuple[float, float] = (1.0, 1.0)):
+                 focal_range: tuple[float, float] = (1.0, 1.0), far_view_prob: float = 0.0):
         self.parts = tuple(SyntheticDataset(kind, split, None, height, width, focal_range) for kind in SYNTHETIC_KINDS)
         self.split, self.height, self.width = split, *check_size(height, width)
         self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
+        self.far_view_prob = check_far_view_prob(far_view_prob)
 
     def __len__(self) -> int:
         return self.size
@@ -261,9 +271,16 @@ class MixedSyntheticDataset:
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for MixedSyntheticDataset({self.split!r}) of size "
                                    f"{self.size}")
-        return self.parts[index % 2][index // 2]
+        frame = self.parts[index % 2][index // 2]
+        if index % 2 or self.far_view_prob == 0.0:
+            return frame
+        rng = far_view_rng(self.split, index // 2)
+        if rng.random() >= self.far_view_prob:
+            return frame
+        return add_far_view(frame, self.parts[1][int(rng.integers(len(self.parts[1])))], rng)
 
     def __repr__(self) -> str:
         focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
+        window = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
         return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
-                f"{focal})")
+                f"{focal}{window})")
