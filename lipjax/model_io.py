@@ -103,7 +103,7 @@ def resolve(name_or_path: str | os.PathLike) -> pathlib.Path:
     candidates = [WEIGHTS_DIR / s] if os.sep not in s and not s.endswith((".json", ".msgpack")) else []
     candidates.append(pathlib.Path(s.rsplit(".", 1)[0] if s.endswith((".json", ".msgpack")) else s))
     for stem in candidates:
-        if _with_suffix(stem, ".json").exists() and _with_suffix(stem, ".msgpack").exists():
+        if stem.name and _with_suffix(stem, ".json").exists() and _with_suffix(stem, ".msgpack").exists():
             return stem
     raise ValueError(
         f"unknown model {s!r}: not a shipped model (available: {', '.join(available()) or 'none'}) "

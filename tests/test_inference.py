@@ -76,6 +76,9 @@ def test_save_and_load_round_trip(tmp_path, completer):
 def test_unknown_model_name_lists_available():
     with pytest.raises(ValueError, match="unknown model 'no-such-model'"):
         lipjax.load_model("no-such-model")
+    for empty in ("", ".json"):  # no file name at all: the same one-line error, not pathlib's
+        with pytest.raises(ValueError, match=f"unknown model '{empty}'"):
+            lipjax.load_model(empty)
 
 
 def test_fewer_iterations_uses_the_first_operators(completer):
