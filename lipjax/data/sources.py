@@ -147,8 +147,8 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         size = data.val_images if split == "val" else None
         focal = (1.0, 1.0) if split == "val" else data.focal_range  # validation: the reference camera
         if data.kind == MIXED_SCENES:
-            window = 0.0 if split == "val" else data.far_view_prob  # validation: closed rooms
-            return MixedSyntheticDataset(split, size, data.height, data.width, focal, window), None
+            far_view = 0.0 if split == "val" else data.far_view_prob  # validation: closed rooms
+            return MixedSyntheticDataset(split, size, data.height, data.width, focal, far_view), None
         if data.far_view_prob:
             raise ValueError(f"data.far_view_prob needs rooms and streets (data.kind='{MIXED_SCENES}'), got "
                              f"data.kind={data.kind!r}; add --set data.kind={MIXED_SCENES} or data.far_view_prob=0")

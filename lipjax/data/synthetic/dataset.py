@@ -24,9 +24,9 @@ from lipjax.data.synthetic.constants import (
     SPLITS,
     SYNTHETIC_KINDS,
 )
+from lipjax.data.synthetic.far_view import add_far_view, check_far_view_prob
 from lipjax.data.synthetic.renderer import render_scene
 from lipjax.data.synthetic.scenes import build_scene
-from lipjax.data.synthetic.far_view import add_far_view, check_far_view_prob
 
 
 @dataclasses.dataclass(frozen=True)
@@ -281,6 +281,6 @@ class MixedSyntheticDataset:
 
     def __repr__(self) -> str:
         focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
-        window = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
+        far_view = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
         return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
-                f"{focal}{window})")
+                f"{focal}{far_view})")

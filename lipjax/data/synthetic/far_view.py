@@ -1,10 +1,10 @@
-"""Windows: a far view inside a room, so that one frame spans the depths of both scene kinds.
+"""Far views: a street through a window inside a room, so that one frame spans the depths of both scene kinds.
 
 A rendered room is closed (every depth within ~11 m); a photograph of a room often is not: windows, open doors
 and glass walls show buildings and trees tens of metres away, and a sparse sensor samples them as it samples the
-walls. A prox trained on closed rooms takes such samples for outliers (the shipped lip-any went from 0.775x to
-1.200x linear on 8 test rooms with a pasted view; docs/design-notes.md). `add_far_view` pastes a rectangle of a
-street render into a room render of the same size:
+walls. A prox trained on closed rooms takes such samples for outliers (`python benchmarks/far_views.py`: the
+228,000-image lip-any, 0.781x linear on 12 closed test rooms, is 1.014x with their windows; docs/design-notes.md).
+`add_far_view` pastes a rectangle of a street render into a room render of the same size:
 
     (t, l, h, w)   the window in the room: h / H in WINDOW_HEIGHT, w / W in WINDOW_WIDTH, t / H in WINDOW_TOP
     (t', l')       where the view is cut from the street frame: t' in its upper VIEW_ROWS (facades, trees, sky)
