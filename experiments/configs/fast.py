@@ -87,6 +87,7 @@ EXPECTED: dict[str, Expected] = {
              "that model (164,000; val 2.5845 m); then 2,000 such steps (180,000; val 2.5571 m); then 4,000 such "
              "steps (212,000; val 2.5167 m, the mean of its last 4 checkpoints); then this config with --set "
              "g_steps=2000 from that one (228,000), exported from its last checkpoint (the mean of its last 4: val "
-             "2.5710 m). All five with texture on one rectangle and the reference camera (texture_patches=1, "
-             "focal_range=(1, 1)); the later runs (docs/training.md) did not ship"),
+             "2.5710 m). All five with texture on one rectangle, the reference camera and closed rooms "
+             "(texture_patches=1, focal_range=(1, 1), far_view_prob=0); the later runs (docs/training.md) did "
+             "not ship"),
 }
