@@ -22,32 +22,19 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from lipjax.data.sampling import UniformSampler  # noqa: E402
+from benchmarks.generalisation import ratio_to_linear  # noqa: E402
 from lipjax.data.synthetic.dataset import MixedSyntheticDataset  # noqa: E402
-from lipjax.inference import complete_frame  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 
-def ratio_to_linear(completer, linear, sample, points: int) -> float:
-    """RMSE of the completer over RMSE of linear on the unsampled valid pixels, `points` uniform samples (seed 0)."""
-    sparse = UniformSampler(points)(sample, 0)
-    keep = sample.valid & (sparse <= 0)
-
-    def rmse(pred):
-        return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
-
-    return rmse(complete_frame(completer, sample.rgb, sparse)) / rmse(linear(sample.rgb, sparse))
-
-
 def run(model: str | None, frames: int, points: int, size: tuple[int, int]) -> dict[str, list[float]]:
-    """{"closed": [...], "window": [...]}: per-room RMSE ratios to linear."""
+    """{"closed": [...], "window": [...]}: per-room RMSE ratios to linear (`generalisation.ratio_to_linear`)."""
     closed = MixedSyntheticDataset("test", 2 * frames, *size)
     windowed = MixedSyntheticDataset("test", 2 * frames, *size, far_view_prob=1.0)
     linear, out = get_completer("linear"), {"closed": [], "window": []}
     for i in range(frames):
         for name, sample in (("closed", closed[2 * i]), ("window", windowed[2 * i])):
-            completer = get_completer(model, sparse=UniformSampler(points)(sample, 0))
-            out[name].append(ratio_to_linear(completer, linear, sample, points))
+            out[name].append(ratio_to_linear(model, linear, sample, f"uniform:{points}"))
         print(f"{closed[2 * i].id}  closed {out['closed'][-1]:.3f}  window {out['window'][-1]:.3f}", flush=True)
     return out
 

@@ -55,14 +55,16 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
     return list(SyntheticDataset(kind, "test", size=n, height=size[0], width=size[1], focal_range=focal))
 
 
-def ratio_to_linear(completer_name, linear, sample, spec: str) -> float:
+def ratio_to_linear(model, linear, sample, spec: str) -> float:
+    """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
+    pixels, with the samples of `spec` (lipjax.data.sampling) drawn with seed 0."""
     sparse = sampler_from_spec(spec)(sample, 0)
     keep = sample.valid & (sparse <= 0)
 
     def rmse(pred):
         return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
 
-    completer = get_completer(completer_name, sparse=sparse)
+    completer = get_completer(model, sparse=sparse)
     return rmse(complete_frame(completer, sample.rgb, sparse)) / rmse(linear(sample.rgb, sparse))
 
 
