@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from lipjax.data import parallax
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import (
     BernoulliSampler,
@@ -20,6 +21,7 @@ from lipjax.data.sampling import (
     LidarSampler,
     Noise,
     Noisy,
+    Parallax,
     UniformSampler,
     example_rng,
     sampler_from_spec,
@@ -213,8 +215,11 @@ def test_sampler_from_spec():
     assert s == Noisy(dataclasses.replace(LidarSampler.vlp32(), azimuth_step_deg=0.4), Noise(0.02, 0.01, 0.05))
     assert sampler_from_spec("keypoint:500") == KeypointSampler(500)
     assert sampler_from_spec("holes:0.3") == HolesSampler(0.3)
+    s = sampler_from_spec("lidar:hdl64+parallax:min_m=0.05,max_m=0.2+noise:rel=0.01")
+    assert s == Noisy(Parallax(LidarSampler.hdl64(), 0.05, 0.2), Noise(relative_std=0.01))
     for bad in ("uniform:abc", "lidar:hdl99", "lidar:vlp16,color=1", "gauss:3", "uniform:3+noise:foo=1",
-                "uniform:3+blur:1", "holes:1.5", "holes:x", "keypoint:many",
+                "uniform:3+blur:1", "holes:1.5", "holes:x", "keypoint:many", "uniform:3+parallax:b=1",
+                "uniform:3+parallax:min_m=0.3,max_m=0.1", "uniform:3+parallax:min_m=0",
                 "keypoint:-1"):
         with pytest.raises(ValueError):
             sampler_from_spec(bad)
@@ -274,3 +279,81 @@ def test_holes_keep_the_depth_but_not_occlusion_edges_and_cover_the_fraction():
         assert abs((1 - kept.mean()) - (fraction + 2 / w * (1 - fraction))) < 0.03
     np.testing.assert_array_equal(HolesSampler(0.3)(s, 0), HolesSampler(0.3)(s, 0))
     assert not np.array_equal(HolesSampler(0.3)(s, 0), HolesSampler(0.3)(s, 1))
+
+
+# ---- parallax (lipjax.data.parallax) -----------------------------------------------------------------------------
+
+# A 2 m box (rows 15-30, columns 20-39) before an 8 m wall; fx = 100 px and a 0.16 m baseline along +x shift the
+# box by fx b / z = 8 px in the sensor's view and the wall by 2 px, both to the left.
+K_BOX = Intrinsics(100.0, 100.0, 31.0, 23.0)
+BOX_NEAR_M, WALL_M, BASELINE_M = 2.0, 8.0, (0.16, 0.0, 0.0)
+
+
+def box_scene() -> np.ndarray:
+    depth = np.full((48, 64), WALL_M, np.float32)
+    depth[15:31, 20:40] = BOX_NEAR_M
+    return depth
+
+
+def test_sensor_view_of_a_box_shifts_by_disparity_and_continues_the_wall():
+    depth = box_scene()
+    view = parallax.sensor_view(depth, depth > 0, K_BOX, BASELINE_M)
+    expected = np.full_like(depth, WALL_M)
+    expected[15:31, 12:32] = BOX_NEAR_M  # box columns 20-39 less 8 px; its old right edge uncovers 32-37 (wall)
+    assert np.array_equal(view, expected)
+
+
+def test_returns_seen_past_the_box_edge_land_on_the_box_with_the_walls_depth():
+    depth = box_scene()
+    view = parallax.sensor_view(depth, depth > 0, K_BOX, BASELINE_M)
+    returns = np.zeros_like(view)
+    returns[:, 32:38] = view[:, 32:38]  # the sensor's returns from the uncovered strip only
+    camera = parallax.to_camera(returns, K_BOX, BASELINE_M)
+    rows, cols = np.nonzero(camera)
+    # wall points (8 m) seen through: the box's right 6 columns (34-39 = 32-37 + 2 px) in its rows; the strip's
+    # rows above and below the box are wall seen as wall
+    assert set(cols) == set(range(34, 40)) and np.all(camera[rows, cols] == WALL_M)
+    assert np.all(depth[15:31, 34:40] == BOX_NEAR_M) and np.all(camera[15:31, 34:40] == WALL_M)
+
+
+def test_sensor_shadow_and_zero_baseline():
+    depth = box_scene()
+    dense = parallax.to_camera(parallax.sensor_view(depth, depth > 0, K_BOX, BASELINE_M), K_BOX, BASELINE_M)
+    # the wall just left of the box (columns 14-19) is hidden from the sensor: no return; so are the camera's two
+    # leftmost columns (outside the sensor's view); every other pixel returns the camera's own depth (the box
+    # hides the wall seen past its edge: the nearer return wins)
+    assert not dense[15:31, 14:20].any() and dense[15:31, 12:14].all() and not dense[:, :2].any()
+    seen = dense > 0
+    assert np.array_equal(dense[seen], depth[seen]) and seen.sum() == 48 * 62 - 16 * 6
+    sample = Sample.from_depth(np.zeros((48, 64, 3), np.uint8), box_scene(), K_BOX, "box")
+    assert np.array_equal(parallax.sensor_view(sample.depth, sample.valid, K_BOX, np.zeros(3)), sample.depth)
+
+
+def test_sensor_view_gives_no_return_where_the_camera_saw_nothing():
+    depth = box_scene()
+    depth[:10] = 0  # sky above row 10
+    view = parallax.sensor_view(depth, depth > 0, K_BOX, BASELINE_M)
+    expected = np.full_like(depth, WALL_M)
+    expected[15:31, 12:32] = BOX_NEAR_M
+    assert not view[:10].any() and np.array_equal(view[10:], expected[10:])
+
+
+def test_parallax_sampler_is_keyed_by_example_and_its_baseline_in_range():
+    sample = random_sample(h=48, w=64, hole_fraction=0.0)
+    sampler = Parallax(UniformSampler(300), min_m=0.05, max_m=0.1)
+    lengths = [np.linalg.norm(sampler.baseline_m(random_sample(id=str(i)), 3)) for i in range(200)]
+    assert 0.05 <= min(lengths) and max(lengths) <= 0.1 and np.median(lengths) == pytest.approx(0.0707, rel=0.1)
+    out = sampler(sample, seed=3)
+    assert np.array_equal(out, sampler(sample, seed=3)) and not np.array_equal(out, sampler(sample, seed=4))
+    # tiny baseline: the same points as the plain sampler, at the camera's depth
+    tiny = Parallax(UniformSampler(300), min_m=1e-6, max_m=1e-6)(sample, seed=3)
+    assert np.array_equal(tiny, UniformSampler(300)(sample, seed=3))
+
+
+def test_sensor_behind_the_camera_sees_a_wall_farther_and_its_returns_come_back_exact():
+    depth = np.full((48, 64), 4.0, np.float32)
+    behind = (0.0, 0.0, -0.5)  # half a metre behind: the view shrinks to the centre; the rim is filled radially
+    view = parallax.sensor_view(depth, depth > 0, K_BOX, behind)
+    assert np.all(view == 4.5)
+    back = parallax.to_camera(view, K_BOX, behind)
+    assert np.all(back[back > 0] == 4.0) and (back > 0).mean() > 0.7

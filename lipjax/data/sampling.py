@@ -12,6 +12,8 @@ Samplers:
   KeypointSampler(n)    up to n valid pixels at image corners (a structure-from-motion / visual SLAM map).
   HolesSampler(f)       every valid pixel but occlusion edges and blobs covering f of the frame (stereo, ToF).
   Noisy(sampler, noise) any sampler followed by a Noise model.
+  Parallax(sampler, lo, hi)  any sampler measuring from a viewpoint 0.03-0.3 m off the camera's (seen-through
+                        edges, shadowed surfaces: lipjax.data.parallax).
 
 `sampler_from_spec("uniform:200")` builds one from a string (CLIs, configs); grammar in its docstring.
 """
@@ -25,6 +27,7 @@ from typing import Protocol
 import cv2
 import numpy as np
 
+from lipjax.data import parallax
 from lipjax.data.sample import Sample
 from lipjax.zbuffer import nearest_per_cell
 
@@ -177,7 +180,8 @@ class LidarSampler:
     on invalid ground truth) keeps none. The result: one scan line per beam that falls in the camera's view,
     with about (horizontal FOV / azimuth_step_deg) points per line.
 
-    Occlusion differences due to the camera-LiDAR baseline are not simulated (only camera-visible pixels exist).
+    The beams start from the camera-visible pixels only; wrap the sampler in `Parallax` for the returns seen
+    through edges and the surfaces shadowed by the camera-LiDAR baseline.
 
     Attributes:
       beams: number of lasers.
@@ -355,9 +359,44 @@ class Noisy:
         return self.noise(self.sampler(sample, seed), sample, seed)
 
 
+@dataclasses.dataclass(frozen=True)
+class Parallax:
+    """`sampler` measuring from a sensor beside the camera, its returns projected into the image.
+
+    Per example a baseline b (metres, camera frame) of length drawn log-uniformly in [min_m, max_m] and direction
+    uniform on the sphere, from example_rng(seed, sample.id, "parallax"). The sampler draws on the depth the sensor
+    sees from b (`lipjax.data.parallax.sensor_view`: the camera's hidden background continued under edges, its
+    invalid pixels kept invalid), and its returns land back in the camera's pixels (`parallax.to_camera`): some on
+    foreground pixels with the background's depth (seen through an edge), none on surfaces the sensor cannot see.
+    The ground truth is untouched: the model learns which samples to distrust.
+    """
+
+    sampler: SparseSampler
+    min_m: float = 0.03
+    max_m: float = 0.3
+
+    def __post_init__(self):
+        if not 0 < self.min_m <= self.max_m:
+            raise ValueError(f"parallax needs 0 < min_m <= max_m metres, got min_m={self.min_m}, max_m={self.max_m}")
+
+    def baseline_m(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        """(3,) this example's sensor position in the camera frame, metres."""
+        rng = example_rng(seed, sample.id, "parallax")
+        length = math.exp(rng.uniform(math.log(self.min_m), math.log(self.max_m)))
+        direction = rng.standard_normal(3)
+        return length * direction / np.linalg.norm(direction)
+
+    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
+        b = self.baseline_m(sample, seed)
+        view = parallax.sensor_view(sample.depth, sample.valid, sample.intrinsics, b)
+        seen = Sample(rgb=sample.rgb, depth=view, valid=view > 0, intrinsics=sample.intrinsics, id=sample.id)
+        return parallax.to_camera(self.sampler(seen, seed), sample.intrinsics, b)
+
+
 LIDAR_PRESETS = {"hdl64": LidarSampler.hdl64, "hdl32": LidarSampler.hdl32,
                  "vlp32": LidarSampler.vlp32, "vlp16": LidarSampler.vlp16}
 _NOISE_KEYS = {"std": "std_m", "rel": "relative_std", "outliers": "outlier_fraction"}
+_PARALLAX_KEYS = {"min_m": "min_m", "max_m": "max_m"}
 
 
 def _parse_options(text: str, spec: str) -> dict[str, float]:
@@ -403,24 +442,29 @@ def draws_scan_lines(spec: str) -> bool:
     """Whether the sampler of `spec` (see `sampler_from_spec`) draws LiDAR scan lines for some examples."""
     sampler = sampler_from_spec(spec)
     parts = sampler.samplers if isinstance(sampler, Mixture) else (sampler,)
-    return any(isinstance(part.sampler if isinstance(part, Noisy) else part, LidarSampler) for part in parts)
+    return any(isinstance(_innermost(part), LidarSampler) for part in parts)
+
+
+def _innermost(sampler: SparseSampler) -> SparseSampler:
+    """The pattern inside any Noisy / Parallax wrappers."""
+    return _innermost(sampler.sampler) if isinstance(sampler, (Noisy, Parallax)) else sampler
 
 
 def _single_sampler_from_spec(spec: str) -> SparseSampler:
     """Builds a sampler from a string.
 
-    Grammar: KIND[+noise:OPTIONS] with KIND one of
+    Grammar: KIND[+parallax:OPTIONS][+noise:OPTIONS] (wrappers applied left to right) with KIND one of
       uniform:N                       UniformSampler(N)
       bernoulli:N                     BernoulliSampler(N)
       lidar:PRESET[,key=value...]     LidarSampler.PRESET(key=value), PRESET in hdl64 hdl32 vlp32 vlp16,
                                       keys: any float field, e.g. azimuth_step_deg=0.4,mount_pitch_deg=-2
       keypoint:N                      KeypointSampler(N)
       holes:F                         HolesSampler(F), F in [0, 1)
-    and noise OPTIONS std=<m>,rel=<fraction>,outliers=<fraction>.
+    parallax OPTIONS min_m=<m>,max_m=<m> (`Parallax`) and noise OPTIONS std=<m>,rel=<fraction>,outliers=<fraction>.
     Examples: "uniform:200", "bernoulli:500", "lidar:vlp16", "lidar:hdl64+noise:std=0.02,outliers=0.01",
-    "keypoint:500", "holes:0.3".
+    "lidar:hdl64+parallax:min_m=0.05,max_m=0.3", "keypoint:500", "holes:0.3".
     """
-    base, _, noise_text = spec.strip().partition("+")
+    base, *suffixes = spec.strip().split("+")
     kind, _, arg = base.partition(":")
     kind = kind.strip().lower()
     sampler: SparseSampler
@@ -450,14 +494,22 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
     else:
         raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N, keypoint:N, holes:F or "
                          f"lidar:{'|'.join(LIDAR_PRESETS)}")
-    if noise_text:
-        name, _, options = noise_text.partition(":")
-        if name.strip() != "noise":
-            raise ValueError(f"sampler spec {spec!r}: expected '+noise:...' after the sampler")
-        raw = _parse_options(options, spec)
-        unknown = set(raw) - set(_NOISE_KEYS)
-        if unknown:
-            raise ValueError(f"sampler spec {spec!r}: unknown noise option(s) {sorted(unknown)}; "
-                             f"known: {sorted(_NOISE_KEYS)}")
-        sampler = Noisy(sampler, Noise(**{_NOISE_KEYS[k]: v for k, v in raw.items()}))
+    for suffix in suffixes:
+        sampler = _wrapped(sampler, suffix, spec)
     return sampler
+
+
+def _wrapped(sampler: SparseSampler, suffix: str, spec: str) -> SparseSampler:
+    """`sampler` inside the wrapper a "+parallax:..." or "+noise:..." suffix of `spec` names."""
+    name, _, options = suffix.partition(":")
+    raw = _parse_options(options, spec)
+    keys = {"noise": _NOISE_KEYS, "parallax": _PARALLAX_KEYS}.get(name.strip())
+    if keys is None:
+        raise ValueError(f"sampler spec {spec!r}: expected '+parallax:...' or '+noise:...' after the sampler, "
+                         f"got '+{suffix}'")
+    unknown = set(raw) - set(keys)
+    if unknown:
+        raise ValueError(f"sampler spec {spec!r}: unknown {name.strip()} option(s) {sorted(unknown)}; "
+                         f"known: {sorted(keys)}")
+    kwargs = {keys[k]: v for k, v in raw.items()}
+    return Noisy(sampler, Noise(**kwargs)) if name.strip() == "noise" else Parallax(sampler, **kwargs)
