@@ -472,7 +472,8 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
         try:
             n = int(arg)
         except ValueError:
-            raise ValueError(f"sampler spec {spec!r}: {kind} needs an integer point count, e.g. '{kind}:200'") from None
+            raise ValueError(
+                f"sampler spec {spec!r}: {kind} needs an integer point count, e.g. '{kind}:200'") from None
         sampler = {"uniform": UniformSampler, "bernoulli": BernoulliSampler, "keypoint": KeypointSampler}[kind](n)
     elif kind == "holes":
         try:
