@@ -55,10 +55,10 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
     return list(SyntheticDataset(kind, "test", size=n, height=size[0], width=size[1], focal_range=focal))
 
 
-def ratio_to_linear(model, linear, sample, spec: str) -> float:
+def ratio_to_linear(model, linear, sample, spec) -> float:
     """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
-    pixels, with the samples of `spec` (lipjax.data.sampling) drawn with seed 0."""
-    sparse = sampler_from_spec(spec)(sample, 0)
+    pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0."""
+    sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(sample, 0)
     keep = sample.valid & (sparse <= 0)
 
     def rmse(pred):

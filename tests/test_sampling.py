@@ -348,6 +348,12 @@ def test_parallax_sampler_is_keyed_by_example_and_its_baseline_in_range():
     # tiny baseline: the same points as the plain sampler, at the camera's depth
     tiny = Parallax(UniformSampler(300), min_m=1e-6, max_m=1e-6)(sample, seed=3)
     assert np.array_equal(tiny, UniformSampler(300)(sample, seed=3))
+    rig = Parallax.at(UniformSampler(300), (0.06, -0.08, -0.27))
+    assert np.allclose(rig.baseline_m(sample, 3), (0.06, -0.08, -0.27)) and np.allclose(rig.baseline_m(sample, 9),
+                                                                                      (0.06, -0.08, -0.27))
+    for bad in ((0, 0, 0), (1, 2)):
+        with pytest.raises(ValueError):
+            Parallax.at(UniformSampler(3), bad)
 
 
 def test_sensor_behind_the_camera_sees_a_wall_farther_and_its_returns_come_back_exact():

@@ -364,7 +364,9 @@ class Parallax:
     """`sampler` measuring from a sensor beside the camera, its returns projected into the image.
 
     Per example a baseline b (metres, camera frame) of length drawn log-uniformly in [min_m, max_m] and direction
-    uniform on the sphere, from example_rng(seed, sample.id, "parallax"). The sampler draws on the depth the sensor
+    uniform on the sphere, from example_rng(seed, sample.id, "parallax"); `Parallax.at(sampler, b)` fixes it (a
+    known rig: KITTI's Velodyne sits at about (0.06, -0.08, -0.27) from its left colour camera). The sampler draws
+    on the depth the sensor
     sees from b (`lipjax.data.parallax.sensor_view`: the camera's hidden background continued under edges, its
     invalid pixels kept invalid), and its returns land back in the camera's pixels (`parallax.to_camera`): some on
     foreground pixels with the background's depth (seen through an edge), none on surfaces the sensor cannot see.
@@ -374,16 +376,29 @@ class Parallax:
     sampler: SparseSampler
     min_m: float = 0.03
     max_m: float = 0.3
+    direction: tuple[float, float, float] | None = None  # a fixed unit direction instead of a random one
 
     def __post_init__(self):
         if not 0 < self.min_m <= self.max_m:
             raise ValueError(f"parallax needs 0 < min_m <= max_m metres, got min_m={self.min_m}, max_m={self.max_m}")
+        if self.direction is not None and not math.isclose(float(np.linalg.norm(self.direction)), 1.0, rel_tol=1e-6):
+            raise ValueError(f"parallax direction must be a unit vector, got {self.direction}")
+
+    @classmethod
+    def at(cls, sampler: SparseSampler, baseline_m) -> "Parallax":
+        """`sampler` measuring from the fixed point `baseline_m` (3,) metres, camera frame (x right, y down, z
+        forward)."""
+        b = np.asarray(baseline_m, np.float64)
+        length = float(np.linalg.norm(b))
+        if b.shape != (3,) or not length > 0:
+            raise ValueError(f"a sensor position needs 3 coordinates in metres, not all 0, got {baseline_m!r}")
+        return cls(sampler, length, length, tuple(float(c) for c in b / length))
 
     def baseline_m(self, sample: Sample, seed: int = 0) -> np.ndarray:
         """(3,) this example's sensor position in the camera frame, metres."""
         rng = example_rng(seed, sample.id, "parallax")
         length = math.exp(rng.uniform(math.log(self.min_m), math.log(self.max_m)))
-        direction = rng.standard_normal(3)
+        direction = rng.standard_normal(3) if self.direction is None else np.asarray(self.direction)
         return length * direction / np.linalg.norm(direction)
 
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
