@@ -201,6 +201,27 @@ def test_relight_is_one_smooth_grey_gain_within_the_strength_and_leaves_depth_al
     assert not np.array_equal(plain.rgb, lit.rgb)
 
 
+def test_quarter_turns_turn_whole_frames_either_way_when_the_turned_frame_holds_the_crop():
+    b = _batch(n=8, h=40, w=48)
+    turned = augment_batch(b, Augment(quarter_turn_prob=1.0), None, seed=0, step=0)
+    assert turned.gt.shape == (8, 48, 40)
+    ways = []
+    for i in range(8):
+        k = [k for k in (1, 3) if np.array_equal(turned.gt[i], np.rot90(b.gt[i], k))]
+        assert len(k) == 1
+        for f in ("rgb", "sparse", "gt_valid"):
+            np.testing.assert_array_equal(getattr(turned, f)[i], np.rot90(getattr(b, f)[i], k[0]))
+        ways.append(k[0])
+    assert set(ways) == {1, 3}
+    # a 40x48 frame turned is 48x40: it holds a 30x36 crop, not a 20x44 one (left upright)
+    upright = augment_batch(b, Augment(quarter_turn_prob=1.0), (20, 44), seed=0, step=0)
+    assert all(any(np.array_equal(upright.gt[i], b.gt[i, t:t + 20, l:l + 44]) for t in range(21) for l in range(5))
+               for i in range(8))
+    small = augment_batch(b, Augment(quarter_turn_prob=1.0), (30, 36), seed=0, step=0)
+    assert all(any(np.array_equal(small.gt[i], np.rot90(b.gt[i], k)[t:t + 30, l:l + 36])
+                   for k in (1, 3) for t in range(19) for l in range(5)) for i in range(8))
+
+
 def test_bad_settings_are_clear_errors():
     with pytest.raises(ValueError, match="zoom"):
         Augment(zoom=(1.5, 1.0))
@@ -210,3 +231,5 @@ def test_bad_settings_are_clear_errors():
         Augment(sensor_noise=1.5)
     with pytest.raises(ValueError, match="illumination"):
         Augment(illumination_prob=2.0)
+    with pytest.raises(ValueError, match="quarter_turn_prob"):
+        Augment(quarter_turn_prob=1.5)

@@ -11,6 +11,11 @@ What each part is for (real sensors and real frames differ from the synthetic re
   than the training renders, e.g. full-size KITTI or Middlebury). RGB is resized with area / bilinear
   interpolation, ground truth by nearest neighbour (depths are never averaged across edges), and every sparse
   sample moves to the pixel of the new grid it falls in, the nearest depth winning where several meet.
+- quarter turn: with probability `quarter_turn_prob` the whole frame is turned by 90 degrees, either way, before the
+  crop (a phone or a robot camera held in portrait; the renders are all upright, and a prox that learned "floor at
+  the bottom" costs on portrait frames: 0.775 -> 0.872x linear on rooms turned at test time, docs/design-notes.md).
+  Only frames whose turned size still holds the crop are turned (rooms 256x320 with 128x160 crops; not 128x416
+  streets with 128x208 crops): a street seen in portrait is rare, and the crop would have to zoom;
 - horizontal flip (geometry stays valid for a pinhole camera; the scenes have no left/right bias);
 - photometric jitter: brightness, contrast and saturation factors in [1 - a, 1 + a] and gamma in
   [1 / (1 + g), 1 + g] (camera exposure, white balance, tone curves);
@@ -55,6 +60,7 @@ class Augment:
     """Augmentation settings (dimensionless unless named). The defaults change nothing but the crop position."""
 
     zoom: tuple[float, float] = (1.0, 1.0)
+    quarter_turn_prob: float = 0.0
     hflip: bool = False
     brightness: float = 0.0
     contrast: float = 0.0
@@ -79,8 +85,10 @@ class Augment:
         for name in ("brightness", "contrast", "saturation"):
             if not 0 <= getattr(self, name) < 1:
                 raise ValueError(f"{name} must be in [0, 1), got {getattr(self, name)}")
-        if not (0 <= self.blur_prob <= 1 and 0 <= self.outlier_fraction <= 1 and 0 <= self.texture_prob <= 1):
-            raise ValueError("blur_prob, outlier_fraction and texture_prob are probabilities in [0, 1]")
+        if not all(0 <= p <= 1 for p in (self.blur_prob, self.outlier_fraction, self.texture_prob,
+                                         self.quarter_turn_prob)):
+            raise ValueError("blur_prob, outlier_fraction, texture_prob and quarter_turn_prob are probabilities in "
+                             "[0, 1]")
         if not (0 <= self.sensor_noise < 1 and 0 <= self.jpeg_prob <= 1):
             raise ValueError("sensor_noise must be in [0, 1) and jpeg_prob in [0, 1]")
         if not (0 <= self.illumination_prob <= 1 and self.illumination_strength >= 0):
@@ -232,6 +240,11 @@ def perturb_samples(sparse: np.ndarray, aug: Augment, rng: np.random.Generator) 
 
 def augment_example(rgb, sparse, gt, valid, crop, aug: Augment, rng: np.random.Generator):
     """One example's (rgb, sparse, gt, valid) -> augmented and cropped to `crop` (None: the full frame)."""
+    if aug.quarter_turn_prob and rng.random() < aug.quarter_turn_prob:
+        turns = int(rng.choice((1, 3)))
+        h, w = gt.shape
+        if crop is None or (w >= crop[0] and h >= crop[1]):  # the turned frame holds the crop
+            rgb, sparse, gt, valid = (np.rot90(a, turns) for a in (rgb, sparse, gt, valid))
     lo, hi = aug.zoom
     scale = float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
     crop = crop or gt.shape
