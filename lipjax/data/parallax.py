@@ -10,7 +10,8 @@ its returns carry the two artefacts of that baseline b (metres, camera frame: x 
 
 Both are made from the camera's own depth map with the camera's intrinsics K and axes (no second render):
 
-    view = sensor_view(depth, K, b)     every valid pixel's point P = z K^-1 (u, v, 1) moved to P - b and projected
+    view = sensor_view(depth, valid, K, b)
+                                        every valid pixel's point P = z K^-1 (u, v, 1) moved to P - b and projected
                                         with K, the nearest kept per pixel; the sensor's own view
     fill the disocclusions of view      pixels no point reached take the farther side's depth: the background is
                                         continued under the foreground (`fill_background`); pixels the camera saw
@@ -18,11 +19,14 @@ Both are made from the camera's own depth map with the camera's intrinsics K and
     sparse = to_camera(y_view, K, b)    a sampler's returns y_view in that view moved back by + b and projected
                                         into the camera, the nearest kept per pixel
 
+The fill walks along epipolar lines (`epipolar_directions`), where a near and a far surface part as the viewpoint
+moves. The hidden background is a guess (the depth of the visible background next to the gap, carried across it): good
+for the narrow gaps of a baseline of centimetres to decimetres, not for a sensor metres away.
+
 Pixel (u, v) has its centre at integer coordinates, as in `lipjax.data.sampling.LidarSampler`.
 """
 from __future__ import annotations
 
-import cv2
 import numpy as np
 
 from lipjax.data.sample import Intrinsics
