@@ -50,15 +50,15 @@ OUTDOOR_DATA = DataConfig(
 )
 # Rooms and streets interleaved, both rendered at 256x320: 50 to 5,000 scattered points, 16- to 64-beam scans at
 # random mount pitch, noise and bleed-through outliers on some, returns seen through edges from a sensor beside the
-# camera (lipjax.data.parallax), image keypoints, dense depth with holes; colour
-# texture without depth edges, light without geometry, camera noise.
+# camera (lipjax.data.parallax), image keypoints, dense depth with holes; colour texture without depth edges, light
+# without geometry, camera noise.
 MIXED_SAMPLER = "|".join((
     "uniform:50", "uniform:200", "uniform:200", "uniform:500", "uniform:1000", "uniform:5000", "bernoulli:2000",
     "uniform:300+noise:rel=0.01,outliers=0.03",
     "lidar:hdl64,azimuth_step_deg=0.4", "lidar:vlp32,azimuth_step_deg=0.3,mount_pitch_deg=-3",
     "lidar:vlp16,azimuth_step_deg=0.4,mount_pitch_deg=2", "lidar:hdl64+noise:rel=0.005,outliers=0.02",
     "keypoint:500", "holes:0.3",  # a structure-from-motion map; a stereo / ToF camera's dense depth with holes
-    # the sensor beside the camera: a LiDAR 5-30 cm off (KITTI's: 28 cm), an RGB-D camera's 2-8 cm
+    # the sensor beside the camera: a LiDAR 5-30 cm off (KITTI's: 29 cm), an RGB-D camera's 2-8 cm
     "lidar:hdl64+parallax:min_m=0.05,max_m=0.3", "uniform:1000+parallax:min_m=0.02,max_m=0.08",
 ))
 # Zoom 0.5 shows whole 256x320 frames at half scale (KITTI-size streets at their working size); texture and camera

@@ -14,8 +14,8 @@ What each part is for (real sensors and real frames differ from the synthetic re
 - quarter turn: with probability `quarter_turn_prob` the whole frame is turned by 90 degrees, either way, before the
   crop (a phone or a robot camera held in portrait; the renders are all upright, and a prox that learned "floor at
   the bottom" costs on portrait frames: 0.775 -> 0.872x linear on rooms turned at test time, docs/design-notes.md).
-  Only frames whose turned size still holds the crop are turned (rooms 256x320 with 128x160 crops; not 128x416
-  streets with 128x208 crops): a street seen in portrait is rare, and the crop would have to zoom;
+  Only frames whose turned size still holds the crop are turned (a 256x320 render with 128x160 crops; not a 128x416
+  street with 128x208 crops, which would have to zoom);
 - horizontal flip (geometry stays valid for a pinhole camera; the scenes have no left/right bias);
 - photometric jitter: brightness, contrast and saturation factors in [1 - a, 1 + a] and gamma in
   [1 / (1 + g), 1 + g] (camera exposure, white balance, tone curves);

@@ -20,8 +20,8 @@ Both are made from the camera's own depth map with the camera's intrinsics K and
                                         into the camera, the nearest kept per pixel
 
 The fill walks along epipolar lines (`epipolar_directions`), where a near and a far surface part as the viewpoint
-moves. The hidden background is a guess (the depth of the visible background next to the gap, carried across it): good
-for the narrow gaps of a baseline of centimetres to decimetres, not for a sensor metres away.
+moves. The hidden background is a guess (the depth of the visible background next to the gap, carried across it):
+good for the narrow gaps of a baseline of centimetres to decimetres, not for a sensor metres away.
 
 Pixel (u, v) has its centre at integer coordinates, as in `lipjax.data.sampling.LidarSampler`.
 """

@@ -12,8 +12,9 @@ Samplers:
   KeypointSampler(n)    up to n valid pixels at image corners (a structure-from-motion / visual SLAM map).
   HolesSampler(f)       every valid pixel but occlusion edges and blobs covering f of the frame (stereo, ToF).
   Noisy(sampler, noise) any sampler followed by a Noise model.
-  Parallax(sampler, lo, hi)  any sampler measuring from a viewpoint 0.03-0.3 m off the camera's (seen-through
-                        edges, shadowed surfaces: lipjax.data.parallax).
+  Parallax(sampler, min_m, max_m)
+                        any sampler measuring from a sensor min_m-max_m metres off the camera (returns seen
+                        through edges, shadowed surfaces: lipjax.data.parallax).
 
 `sampler_from_spec("uniform:200")` builds one from a string (CLIs, configs); grammar in its docstring.
 """
@@ -366,10 +367,10 @@ class Parallax:
     Per example a baseline b (metres, camera frame) of length drawn log-uniformly in [min_m, max_m] and direction
     uniform on the sphere, from example_rng(seed, sample.id, "parallax"); `Parallax.at(sampler, b)` fixes it (a
     known rig: KITTI's Velodyne sits at about (0.06, -0.08, -0.27) from its left colour camera). The sampler draws
-    on the depth the sensor
-    sees from b (`lipjax.data.parallax.sensor_view`: the camera's hidden background continued under edges, its
-    invalid pixels kept invalid), and its returns land back in the camera's pixels (`parallax.to_camera`): some on
-    foreground pixels with the background's depth (seen through an edge), none on surfaces the sensor cannot see.
+    on the depth the sensor sees from b (`lipjax.data.parallax.sensor_view`: the camera's hidden background
+    continued under edges, its invalid pixels kept invalid), and its returns land back in the camera's pixels
+    (`parallax.to_camera`): some on foreground pixels with the background's depth (seen through an edge), none on
+    surfaces the sensor cannot see.
     The ground truth is untouched: the model learns which samples to distrust.
     """
 
