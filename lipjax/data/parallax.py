@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from lipjax.data.sample import Intrinsics
-from lipjax.zbuffer import splat_nearest
+from lipjax.pointcloud import backproject, project_lidar_to_depth
 
 MIN_VIEW_DEPTH_M = 0.05  # points closer than this to the sensor (or behind it) are not seen
 MAX_FILL_PX = 64  # a hole takes the background from at most this many pixels away (along its epipolar line)
@@ -38,19 +38,12 @@ MAX_FILL_PX = 64  # a hole takes the background from at most this many pixels aw
 
 def _move(depth: np.ndarray, valid: np.ndarray, k: Intrinsics, shift_m: np.ndarray) -> np.ndarray:
     """(H, W) z-depth metres of the valid pixels, their points moved by `shift_m` and projected with K into an
-    (H, W) image, the nearest per pixel (0 where none)."""
-    h, w = depth.shape
-    idx = np.flatnonzero(valid & (depth > 0))
-    v, u = np.divmod(idx, w)
-    z = depth.reshape(-1)[idx].astype(np.float64)
-    x, y = (u - k.cx) / k.fx * z + shift_m[0], (v - k.cy) / k.fy * z + shift_m[1]
-    z = z + shift_m[2]
-    seen = z > MIN_VIEW_DEPTH_M
-    x, y, z = x[seen], y[seen], z[seen]
-    u2 = np.rint(k.fx * x / z + k.cx).astype(np.int64)
-    v2 = np.rint(k.fy * y / z + k.cy).astype(np.int64)
-    inside = (u2 >= 0) & (u2 < w) & (v2 >= 0) & (v2 < h)
-    return splat_nearest(v2[inside] * w + u2[inside], z[inside].astype(np.float32), (h, w))
+    (H, W) image, the nearest per pixel (0 where none): `pointcloud.backproject`, then
+    `pointcloud.project_lidar_to_depth` with the pure translation as the rigid transform."""
+    moved = np.eye(4)
+    moved[:3, 3] = shift_m
+    points = backproject(np.where(valid, depth, 0.0), k)
+    return project_lidar_to_depth(points, k, moved, depth.shape, min_depth_m=MIN_VIEW_DEPTH_M)
 
 
 def epipolar_directions(rows: np.ndarray, cols: np.ndarray, k: Intrinsics, baseline_m) -> np.ndarray:

@@ -405,7 +405,7 @@ class Parallax:
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
         b = self.baseline_m(sample, seed)
         view = parallax.sensor_view(sample.depth, sample.valid, sample.intrinsics, b)
-        seen = Sample(rgb=sample.rgb, depth=view, valid=view > 0, intrinsics=sample.intrinsics, id=sample.id)
+        seen = Sample.from_depth(sample.rgb, view, sample.intrinsics, sample.id)
         return parallax.to_camera(self.sampler(seen, seed), sample.intrinsics, b)
 
 
