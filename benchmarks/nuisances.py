@@ -1,0 +1,137 @@
+"""What in a photograph could make the image worthless to the prox? Photographs' nuisances put on the renders.
+
+    python benchmarks/nuisances.py [--model PATH] [--frames 8]
+
+On the shared real frames the default model given a grey image does as well as with the photograph, while on the
+renders the image is worth 12-50 % (docs/design-notes.md, "RGB guidance from renders to photographs"). This puts one
+nuisance at a time on test-split renders (never trained on), each frame at full size through the default path
+(`lipjax.inference.complete_frame`), and gives the RMSE ratio to the Delaunay linear fill with the image and with a
+uniform grey one; their quotient is the image's worth (grey / image: above 1, the image helps). A nuisance that
+takes the worth to about 1 on the renders is a candidate cause; one that leaves it is not.
+
+    RGB shifted by 2 / 4 px    the photograph misregistered against the depth sensor (calibration, rolling
+                               shutter, time offsets): every colour edge beside its depth edge
+    depth noise 1 % / 3 %      independent per-pixel noise on the depth map, so on the samples and the ground truth
+                               alike (a consumer camera's depth, KITTI's accumulated scans)
+    depth wobble 2 %           a smooth relative error over the frame (structured-light distortion)
+    relit                      a smooth gain field on the image (`lipjax.data.augment.relight`, strength 0.7)
+    camera noise               2 % Gaussian noise and a JPEG round trip at quality 30-95 (`camera_noise`)
+    texture, 3 patches         colour patterns without depth on 3 rectangles (`paint_texture`, strength 0.7)
+    no depth at edges          no valid depth within 2 px of a depth edge (a log-depth step over 0.05 between
+                               neighbours), as a structured-light or stereo camera loses it: neither samples nor
+                               ground truth there, where the image helps most on the renders
+
+Rooms at 480x640 with 200 uniform points, streets at 352x1216 with the HDL-64 pattern; samples drawn with seed 0
+after the nuisance; every nuisance's draws come from (frame, nuisance) alone, so runs repeat exactly.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+import sys
+import zlib
+
+import cv2
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+from benchmarks.generalisation import frames, ratio_to_linear  # noqa: E402
+from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
+from lipjax.methods import get_completer  # noqa: E402
+
+SCENES = (("rooms 200 points", "indoor", (480, 640), "uniform:200"),
+          ("streets HDL-64", "outdoor", (352, 1216), "lidar:hdl64"))
+WOBBLE_GRID = (12, 16)  # cells of the smooth relative depth error, rows x columns
+EDGE_LOG_STEP = 0.05  # a depth edge: |log D(p) - log D(q)| above this between 4-neighbours
+
+
+def shifted(sample, px: int):
+    """The image moved px pixels right and down against the depth (edge pixels repeated)."""
+    rgb = np.pad(sample.rgb, ((px, 0), (px, 0), (0, 0)), mode="edge")[:sample.rgb.shape[0], :sample.rgb.shape[1]]
+    return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
+
+
+def depth_times(sample, factor: np.ndarray):
+    """Depth times a per-pixel factor on the valid pixels (the samples are drawn from this depth afterwards)."""
+    depth = np.where(sample.valid, sample.depth * factor, sample.depth).astype(np.float32)
+    return dataclasses.replace(sample, depth=depth)
+
+
+def noisy(sample, rel: float, rng: np.random.Generator):
+    return depth_times(sample, 1.0 + rel * rng.standard_normal(sample.depth.shape))
+
+
+def wobbled(sample, rel: float, rng: np.random.Generator):
+    grid = rng.standard_normal(WOBBLE_GRID).astype(np.float32)
+    field = cv2.resize(grid, sample.depth.shape[::-1], interpolation=cv2.INTER_CUBIC)
+    return depth_times(sample, 1.0 + rel * field)
+
+
+def with_rgb(sample, rgb: np.ndarray):
+    return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
+
+
+def edges_lost(sample, px: int = 2):
+    log_d = np.log(np.where(sample.valid, sample.depth, 1.0))
+    step = np.zeros(sample.depth.shape, bool)
+    step[:-1] |= np.abs(np.diff(log_d, axis=0)) > EDGE_LOG_STEP
+    step[:, :-1] |= np.abs(np.diff(log_d, axis=1)) > EDGE_LOG_STEP
+    near = cv2.dilate(step.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)) > 0
+    return dataclasses.replace(sample, valid=sample.valid & ~near)
+
+
+def textured(sample, patches: int, rng: np.random.Generator):
+    rgb = sample.rgb
+    for _ in range(patches):
+        rgb = paint_texture(np.ascontiguousarray(rgb), 0.7, rng)
+    return with_rgb(sample, rgb)
+
+
+NUISANCES = {  # name -> (sample, rng) -> sample
+    "none": lambda s, rng: s,
+    "RGB shifted by 2 px": lambda s, rng: shifted(s, 2),
+    "RGB shifted by 4 px": lambda s, rng: shifted(s, 4),
+    "depth noise 1 %": lambda s, rng: noisy(s, 0.01, rng),
+    "depth noise 3 %": lambda s, rng: noisy(s, 0.03, rng),
+    "depth wobble 2 %": lambda s, rng: wobbled(s, 0.02, rng),
+    "relit": lambda s, rng: with_rgb(s, relight(s.rgb, 0.7, rng)),
+    "camera noise": lambda s, rng: with_rgb(s, camera_noise(s.rgb, Augment(sensor_noise=0.02, jpeg_prob=1.0), rng)),
+    "texture, 3 patches": lambda s, rng: textured(s, 3, rng),
+    "no depth at edges": lambda s, rng: edges_lost(s),
+}
+
+
+def geomean(r) -> float:
+    return float(np.exp(np.log(np.asarray(r)).mean()))
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
+    ap.add_argument("--frames", type=int, default=8, help="test frames per scene")
+    ap.add_argument("--only", default=None, help="comma-separated nuisances to run (default: all; 'none' is the "
+                                                 "clean frame)")
+    args = ap.parse_args(argv)
+    names = list(NUISANCES) if args.only is None else [n.strip() for n in args.only.split(",")]
+    unknown = sorted(set(names) - set(NUISANCES))
+    if unknown:
+        ap.error(f"unknown nuisance(s) {unknown}; choose from {list(NUISANCES)}")
+    linear = get_completer("linear")
+    print("| scene | nuisance | ratio to linear, image | grey image | image's worth (grey / image) | wins |")
+    print("|---|---|---:|---:|---:|---:|")
+    for scene, kind, size, spec in SCENES:
+        clean = frames(kind, size, None, args.frames)
+        for name in names:
+            nuisance = NUISANCES[name]
+            seeds = [zlib.crc32(f"{s.id}/{name}".encode()) for s in clean]
+            spoilt = [nuisance(s, np.random.default_rng(seed)) for s, seed in zip(clean, seeds)]
+            image = [ratio_to_linear(args.model, linear, s, spec) for s in spoilt]
+            grey = [ratio_to_linear(args.model, linear, with_rgb(s, np.full_like(s.rgb, 128)), spec) for s in spoilt]
+            print(f"| {scene} | {name} | {geomean(image):.3f} | {geomean(grey):.3f} | "
+                  f"{geomean(grey) / geomean(image):.3f} | {sum(r < 1 for r in image)}/{len(image)} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
