@@ -60,20 +60,24 @@ def depth_times(sample, factor: np.ndarray):
 
 
 def noisy(sample, rel: float, rng: np.random.Generator):
+    """Depth times 1 + rel n, n ~ N(0, 1) independently per pixel."""
     return depth_times(sample, 1.0 + rel * rng.standard_normal(sample.depth.shape))
 
 
 def wobbled(sample, rel: float, rng: np.random.Generator):
+    """Depth times 1 + rel f, f a standard normal field on WOBBLE_GRID cells, bicubically enlarged."""
     grid = rng.standard_normal(WOBBLE_GRID).astype(np.float32)
     field = cv2.resize(grid, sample.depth.shape[::-1], interpolation=cv2.INTER_CUBIC)
     return depth_times(sample, 1.0 + rel * field)
 
 
 def with_rgb(sample, rgb: np.ndarray):
+    """The sample with another image."""
     return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
 
 
 def edges_lost(sample, px: int = 2):
+    """No valid depth within px pixels of a depth edge (EDGE_LOG_STEP), so no sample and no score there."""
     log_d = np.log(np.where(sample.valid, sample.depth, 1.0))
     step = np.zeros(sample.depth.shape, bool)
     step[:-1] |= np.abs(np.diff(log_d, axis=0)) > EDGE_LOG_STEP
@@ -83,6 +87,7 @@ def edges_lost(sample, px: int = 2):
 
 
 def textured(sample, patches: int, rng: np.random.Generator):
+    """`paint_texture` at strength 0.7 on `patches` rectangles of the image."""
     rgb = sample.rgb
     for _ in range(patches):
         rgb = paint_texture(np.ascontiguousarray(rgb), 0.7, rng)
@@ -104,6 +109,7 @@ NUISANCES = {  # name -> (sample, rng) -> sample
 
 
 def geomean(r) -> float:
+    """Geometric mean of positive ratios."""
     return float(np.exp(np.log(np.asarray(r)).mean()))
 
 
