@@ -58,14 +58,20 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
 def ratio_to_linear(model, linear, sample, spec) -> float:
     """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
     pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0."""
+    return ratios_to_linear(model, linear, sample, spec, (sample.rgb,))[0]
+
+
+def ratios_to_linear(model, linear, sample, spec, images) -> list[float]:
+    """`ratio_to_linear` with each of `images` in place of the sample's own, the samples and the linear fill (which
+    uses no image) computed once."""
     sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(sample, 0)
     keep = sample.valid & (sparse <= 0)
 
     def rmse(pred):
         return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
 
-    completer = get_completer(model, sparse=sparse)
-    return rmse(complete_frame(completer, sample.rgb, sparse)) / rmse(linear(sample.rgb, sparse))
+    completer, reference = get_completer(model, sparse=sparse), rmse(linear(sample.rgb, sparse))
+    return [rmse(complete_frame(completer, rgb, sparse)) / reference for rgb in images]
 
 
 def main(argv=None) -> None:

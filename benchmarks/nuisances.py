@@ -3,7 +3,7 @@
     python benchmarks/nuisances.py [--model PATH] [--frames 8]
 
 On the shared real frames the default model given a grey image does as well as with the photograph, while on the
-renders the image is worth 12-50 % (docs/design-notes.md, "RGB guidance from renders to photographs"). This puts one
+renders the image is worth 16-54 % (docs/design-notes.md, "RGB guidance from renders to photographs"). This puts one
 nuisance at a time on test-split renders (never trained on), each frame at full size through the default path
 (`lipjax.inference.complete_frame`), and gives the RMSE ratio to the Delaunay linear fill with the image and with a
 uniform grey one; their quotient is the image's worth (grey / image: above 1, the image helps). A nuisance that
@@ -17,9 +17,9 @@ takes the worth to about 1 on the renders is a candidate cause; one that leaves 
     relit                      a smooth gain field on the image (`lipjax.data.augment.relight`, strength 0.7)
     camera noise               2 % Gaussian noise and a JPEG round trip at quality 30-95 (`camera_noise`)
     texture, 3 patches         colour patterns without depth on 3 rectangles (`paint_texture`, strength 0.7)
-    no depth at edges          no valid depth within 2 px of a depth edge (a log-depth step over 0.05 between
-                               neighbours), as a structured-light or stereo camera loses it: neither samples nor
-                               ground truth there, where the image helps most on the renders
+    no depth at edges          no valid depth at failure_look's "depth edge" pixels (within 3 px of a log-depth
+                               step over 0.05 per pixel), as a structured-light or stereo camera loses it: neither
+                               samples nor ground truth there, where the image helps most on the renders
 
 Rooms at 480x640 with 200 uniform points, streets at 352x1216 with the HDL-64 pattern; samples drawn with seed 0
 after the nuisance; every nuisance's draws come from (frame, nuisance) alone, so runs repeat exactly.
@@ -37,20 +37,20 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from benchmarks.generalisation import frames, ratio_to_linear  # noqa: E402
+from benchmarks.failure_look import pixel_classes  # noqa: E402
+from benchmarks.generalisation import frames, ratios_to_linear  # noqa: E402
 from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 SCENES = (("rooms 200 points", "indoor", (480, 640), "uniform:200"),
           ("streets HDL-64", "outdoor", (352, 1216), "lidar:hdl64"))
 WOBBLE_GRID = (12, 16)  # cells of the smooth relative depth error, rows x columns
-EDGE_LOG_STEP = 0.05  # a depth edge: |log D(p) - log D(q)| above this between 4-neighbours
 
 
 def shifted(sample, px: int):
     """The image moved px pixels right and down against the depth (edge pixels repeated)."""
     rgb = np.pad(sample.rgb, ((px, 0), (px, 0), (0, 0)), mode="edge")[:sample.rgb.shape[0], :sample.rgb.shape[1]]
-    return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
+    return with_rgb(sample, rgb)
 
 
 def depth_times(sample, factor: np.ndarray):
@@ -76,14 +76,10 @@ def with_rgb(sample, rgb: np.ndarray):
     return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
 
 
-def edges_lost(sample, px: int = 2):
-    """No valid depth within px pixels of a depth edge (EDGE_LOG_STEP), so no sample and no score there."""
-    log_d = np.log(np.where(sample.valid, sample.depth, 1.0))
-    step = np.zeros(sample.depth.shape, bool)
-    step[:-1] |= np.abs(np.diff(log_d, axis=0)) > EDGE_LOG_STEP
-    step[:, :-1] |= np.abs(np.diff(log_d, axis=1)) > EDGE_LOG_STEP
-    near = cv2.dilate(step.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)) > 0
-    return dataclasses.replace(sample, valid=sample.valid & ~near)
+def edges_lost(sample):
+    """No valid depth at failure_look's depth-edge pixels, so no sample and no score there."""
+    edge = pixel_classes(sample.rgb, sample.depth, sample.valid) == 0
+    return dataclasses.replace(sample, valid=sample.valid & ~edge)
 
 
 def textured(sample, patches: int, rng: np.random.Generator):
@@ -133,8 +129,8 @@ def main(argv=None) -> None:
             nuisance = NUISANCES[name]
             seeds = [zlib.crc32(f"{s.id}/{name}".encode()) for s in clean]
             spoilt = [nuisance(s, np.random.default_rng(seed)) for s, seed in zip(clean, seeds)]
-            image = [ratio_to_linear(args.model, linear, s, spec) for s in spoilt]
-            grey = [ratio_to_linear(args.model, linear, with_rgb(s, np.full_like(s.rgb, 128)), spec) for s in spoilt]
+            image, grey = zip(*(ratios_to_linear(args.model, linear, s, spec, (s.rgb, np.full_like(s.rgb, 128)))
+                                for s in spoilt))
             print(f"| {scene} | {name} | {geomean(image):.3f} | {geomean(grey):.3f} | "
                   f"{geomean(grey) / geomean(image):.3f} | {sum(r < 1 for r in image)}/{len(image)} |", flush=True)
 
