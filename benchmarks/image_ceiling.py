@@ -2,25 +2,33 @@
 
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
-    python benchmarks/image_ceiling.py [--model NAME] [--synthetic 8] [--realdata ../shared/realdata] [--json OUT]
+    python benchmarks/image_ceiling.py [--model NAME] [--synthetic 8] [--variants grey,shading,...]
+                                       [--realdata ../shared/realdata] [--json OUT]
 
 On the renders the photograph is worth about 16 % to the default model (RMSE with a grey image / with the
 photograph), on the shared real frames about 1 % (docs/design-notes.md). Either the prox cannot read photographs,
-or a real room gives the image less to add. This feeds the same 200 samples with four images and gives each RMSE
+or a real room gives the image less to add. This feeds the same 200 samples with six images and gives each RMSE
 ratio to the Delaunay linear fill, default path at native size (`complete_frame`):
 
     photograph   the frame's own image
     grey         uniform grey (GREY): the depth-only part of the prior
-    regions      an image made from the ground truth, the renders' cleanest cue: the connected regions between
-                 depth edges (|d log D| > DEPTH_EDGE per pixel along x or y, on the ground truth with its holes
-                 filled by the nearest valid pixel), each a flat random colour; edge pixels take the nearest region;
-                 the geometric mean over REGION_DRAWS draws of the colours (one draw's ratio moves by up to ~0.15)
+    edges        an image made from the ground truth, the renders' cleanest cue: light grey, with the depth edges
+                 (|d log D| > DEPTH_EDGE per pixel along x or y, on the ground truth with its holes filled by the
+                 nearest valid pixel) drawn dark, EDGE_WIDTH_PX wide: where the surfaces break, nothing else
+    shading      an image from the ground truth: a grey, uniformly white world lit by one light from the
+                 camera's upper left (LIGHT_DIR, camera frame), Lambertian: AMBIENT + (1 - AMBIENT) max(0, n . l),
+                 n the normals of the back-projected ground truth (holes filled by the nearest valid pixel,
+                 smoothed over NORMAL_BLUR_PX): shape shown by shading alone, the renders' other cue
+    both         the shading with the depth edges drawn dark on it
     flattened    the photograph after mean-shift filtering (MEAN_SHIFT_SP / _SR): texture gone, strong edges kept
 
 Frames: the 12 shared indoor frames (NYU v2 3, Middlebury 1, lingbot 8; 200 uniform points as
-benchmarks/real_frames.py draws them) and `--synthetic N` test renders of rooms at 480x640. "regions" is what the
-renders teach the prox to expect of an image, handed over exactly on a real frame: if it is worth little there too,
-the real frames' loss lies on the depth side of the prior, and no image realism can close it.
+benchmarks/real_frames.py draws them) and `--synthetic N` test renders of rooms at 480x640; `--variants` runs
+some (grey always among them). A variant's worth: RMSE with the grey image / with the variant's. The images
+drawn from the ground truth hand the prox one cue each, on real rooms as on renders: a cue worth as much on both is
+one the prox can use in real geometry, and what a photograph lacks is that cue's visibility; a cue worth less on
+real rooms points to the depth side of the prior, or to the cue's own quality there (real ground truth is noisy
+and has holes, so its normals, and so its shading, are bumpier than a render's).
 """
 from __future__ import annotations
 
@@ -28,7 +36,6 @@ import argparse
 import json
 import os
 import sys
-import zlib
 
 import cv2
 import numpy as np
@@ -43,8 +50,12 @@ from lipjax.inference import complete_frame  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 MEAN_SHIFT_SP, MEAN_SHIFT_SR = 12, 24  # cv2.pyrMeanShiftFiltering's spatial (px) and colour (0-255) windows
-REGION_DRAWS = 3  # colourings of the regions image per frame
-VARIANTS = ("photograph", "grey", "regions", "flattened")
+EDGE_WIDTH_PX = 2
+EDGE_GREY, BACKGROUND_GREY = 40, 200
+LIGHT_DIR = (-0.4, -0.6, -0.7)  # towards the light, camera frame (x right, y down, z forward); normalised
+AMBIENT = 0.25
+NORMAL_BLUR_PX = 2.0  # Gaussian sigma on the back-projected points before the normals
+VARIANTS = ("photograph", "grey", "edges", "shading", "both", "flattened")
 
 
 def _nearest_valid(a: np.ndarray, missing: np.ndarray) -> np.ndarray:
@@ -52,32 +63,52 @@ def _nearest_valid(a: np.ndarray, missing: np.ndarray) -> np.ndarray:
     return a[tuple(idx)]
 
 
-def regions_image(depth: np.ndarray, valid: np.ndarray, seed: int) -> np.ndarray:
-    """(H, W, 3) uint8: the ground truth's regions between depth edges, one flat random colour each."""
+def depth_edges(depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """(H, W) bool: pixels beside a log-depth step over DEPTH_EDGE along x or y, EDGE_WIDTH_PX wide."""
     ok = valid & (depth > 0)
     log_d = np.log(_nearest_valid(np.where(ok, depth, 1.0), ~ok))
     edge = np.zeros(depth.shape, bool)
     edge[:, :-1] |= np.abs(np.diff(log_d, axis=1)) > DEPTH_EDGE
     edge[:-1, :] |= np.abs(np.diff(log_d, axis=0)) > DEPTH_EDGE
-    n, labels = cv2.connectedComponents((~edge).astype(np.uint8), connectivity=4)
-    colours = np.random.default_rng(seed).integers(30, 230, (n, 3)).astype(np.uint8)
-    return colours[_nearest_valid(labels, edge)]
+    return cv2.dilate(edge.astype(np.uint8), np.ones((EDGE_WIDTH_PX,) * 2, np.uint8)).astype(bool)
+
+
+def _grey_rgb(grey: np.ndarray) -> np.ndarray:
+    return np.repeat(np.round(grey).astype(np.uint8)[..., None], 3, axis=-1)
+
+
+def shading_image(depth: np.ndarray, valid: np.ndarray, intrinsics) -> np.ndarray:
+    """(H, W, 3) uint8: the ground truth's surfaces, white and Lambertian under one light (module docstring)."""
+    ok = valid & (depth > 0)
+    z = ndimage.gaussian_filter(_nearest_valid(np.where(ok, depth, 0.0), ~ok), NORMAL_BLUR_PX)
+    v, u = np.mgrid[:depth.shape[0], :depth.shape[1]]
+    points = np.stack([(u - intrinsics.cx) / intrinsics.fx * z, (v - intrinsics.cy) / intrinsics.fy * z, z], -1)
+    normal = np.cross(np.gradient(points, axis=1), np.gradient(points, axis=0))
+    normal /= np.maximum(np.linalg.norm(normal, axis=-1, keepdims=True), 1e-12)
+    normal *= -np.sign(normal[..., 2:3] + 1e-12)  # towards the camera (n_z < 0)
+    light = np.asarray(LIGHT_DIR) / np.linalg.norm(LIGHT_DIR)
+    return _grey_rgb(255 * (AMBIENT + (1 - AMBIENT) * np.clip(normal @ light, 0.0, 1.0)))
 
 
 def geomean(r) -> float:
     return float(np.exp(np.log(np.asarray(r)).mean()))
 
 
-def variant_ratios(completer, sample, sparse, reference: float) -> dict[str, float]:
-    """RMSE ratio to `reference` (linear's RMSE) of the model fed each variant's image."""
-    def ratio(rgb):
-        return rmse(complete_frame(completer, rgb, sparse), sample, sparse) / reference
-
-    seed = zlib.crc32(sample.id.encode())
-    flattened = cv2.pyrMeanShiftFiltering(np.ascontiguousarray(sample.rgb), MEAN_SHIFT_SP, MEAN_SHIFT_SR)
-    regions = [regions_image(sample.depth, sample.valid, seed + k) for k in range(REGION_DRAWS)]
-    return {"photograph": ratio(sample.rgb), "grey": ratio(np.full_like(sample.rgb, GREY)),
-            "regions": geomean([ratio(rgb) for rgb in regions]), "flattened": ratio(flattened)}
+def variant_image(sample, variant: str) -> np.ndarray:
+    """(H, W, 3) uint8: the image of one variant for `sample`."""
+    if variant == "photograph":
+        return sample.rgb
+    if variant == "grey":
+        return np.full_like(sample.rgb, GREY)
+    if variant == "edges":
+        return _grey_rgb(np.where(depth_edges(sample.depth, sample.valid), EDGE_GREY, BACKGROUND_GREY))
+    if variant == "shading":
+        return shading_image(sample.depth, sample.valid, sample.intrinsics)
+    if variant == "both":
+        edges = depth_edges(sample.depth, sample.valid)[..., None]
+        shading = shading_image(sample.depth, sample.valid, sample.intrinsics)
+        return np.where(edges, EDGE_GREY, shading).astype(np.uint8)
+    return cv2.pyrMeanShiftFiltering(np.ascontiguousarray(sample.rgb), MEAN_SHIFT_SP, MEAN_SHIFT_SR)
 
 
 def main(argv=None) -> None:
@@ -85,8 +116,12 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--synthetic", type=int, default=8, help="test renders of rooms (480x640)")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--variants", default=",".join(VARIANTS), help="comma-separated, from " + ", ".join(VARIANTS))
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)
+    variants = [v.strip() for v in args.variants.split(",")]
+    if set(variants) - set(VARIANTS) or not {"grey"} <= set(variants):
+        ap.error(f"--variants must include grey (the worth's reference) and come from {VARIANTS}, got {variants}")
     frames = [("real", s, sparse) for group, s, sparse, _ in frames_and_inputs(os.path.abspath(args.realdata))
               if group == "indoor"]
     renders = SyntheticDataset("indoor", "test", size=args.synthetic, height=480, width=640)
@@ -95,16 +130,19 @@ def main(argv=None) -> None:
     for group, sample, sparse in frames:
         completer = get_completer(args.model, sparse=sparse)
         reference = rmse(linear(sample.rgb, sparse), sample, sparse)
-        row = {"group": group, "frame": sample.id, **variant_ratios(completer, sample, sparse, reference)}
+        row = {"group": group, "frame": sample.id}
+        for v in variants:
+            row[v] = rmse(complete_frame(completer, variant_image(sample, v), sparse), sample, sparse) / reference
         rows.append(row)
-        print(f"{sample.id:34s} " + "  ".join(f"{v} {row[v]:.3f}" for v in VARIANTS), flush=True)
-    print("\n| frames | n | " + " | ".join(VARIANTS) + " | worth: photograph | worth: regions |")
-    print("|---|---:|" + "---:|" * (len(VARIANTS) + 2))
+        print(f"{sample.id:34s} " + "  ".join(f"{v} {row[v]:.3f}" for v in variants), flush=True)
+    others = [v for v in variants if v != "grey"]
+    print("\n| frames | n | " + " | ".join(variants) + " | " + " | ".join(f"worth: {v}" for v in others) + " |")
+    print("|---|---:|" + "---:|" * (len(variants) + len(others)))
     for group in ("real", "renders"):
-        g = {v: geomean([r[v] for r in rows if r["group"] == group]) for v in VARIANTS}
+        g = {v: geomean([r[v] for r in rows if r["group"] == group]) for v in variants}
         n = sum(r["group"] == group for r in rows)
-        print(f"| {group} | {n} | " + " | ".join(f"{g[v]:.3f}" for v in VARIANTS)
-              + f" | {g['grey'] / g['photograph']:.3f} | {g['grey'] / g['regions']:.3f} |")
+        print(f"| {group} | {n} | " + " | ".join(f"{g[v]:.3f}" for v in variants) + " | "
+              + " | ".join(f"{g['grey'] / g[v]:.3f}" for v in others) + " |")
     if args.json:
         with open(args.json, "w") as f:
             json.dump(rows, f, indent=1)
