@@ -51,7 +51,8 @@ def crops(split: str, count: int, completer):
     out = {"rgb": [], "gt": [], "valid": [], "fake": []}
     for step, batch in enumerate(it):
         batch = augment_batch(batch, Augment(), CROP, seed=0, step=step)
-        fake = np.asarray(run(completer.params, batch.rgb, batch.sparse, completer.config.host_inputs(batch.sparse))[0])
+        host = completer.config.host_inputs(batch.sparse)
+        fake = np.asarray(run(completer.params, batch.rgb, batch.sparse, host)[0])
         out["rgb"].append(batch.rgb.astype(np.float32) / 255.0)
         out["gt"].append(batch.gt)
         out["valid"].append(batch.gt_valid)

@@ -91,7 +91,8 @@ def main(argv=None) -> dict:
         "title": f"Table I: {config.num_points} points, {data_name}",
         "description": f"protocol {protocol.name}; sampler uniform:{config.num_points} (exactly N valid pixels, keyed "
                        f"by frame id, seed {config.seed}); {next(iter(results.values())).num_images} images; metrics "
-                       f"per image over valid GT in [{protocol.min_depth_m}, {protocol.max_depth_m}] m, then averaged.",
+                       f"per image over valid GT in [{protocol.min_depth_m}, {protocol.max_depth_m}] m, then "
+                       "averaged.",
         "dataset": data_name, "protocol": protocol.name, "sampler": f"uniform:{config.num_points}",
         "seed": config.seed, "num_images": next(iter(results.values())).num_images, "variant": args.variant,
     }

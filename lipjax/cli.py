@@ -7,10 +7,10 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
-    lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val]  (as training reads)
+    lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] [--scattered] --out FILE
-    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]   (fine-tune on your frames)
+    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]  (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
 
@@ -134,8 +134,8 @@ def _add_lidar_args(p, required: bool) -> None:
     p.add_argument("--lidar", required=required, metavar="SWEEP",
                    help="LiDAR sweep: KITTI .bin, .npy (N, >=3) x y z metres, or .pcd")
     p.add_argument("--calib", required=required, metavar="FILE",
-                   help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig .txt/.yaml "
-                        "with K and T_cam_from_lidar")
+                   help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig "
+                        ".txt/.yaml with K and T_cam_from_lidar")
     p.add_argument("--camera", type=int, default=2, metavar="N", help="KITTI camera of --rgb: 2 (image_2) or 3")
 
 
@@ -252,8 +252,8 @@ def _add_data_parser(sub) -> None:
 def _add_train_parser(sub) -> None:
     t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames")
     t.add_argument("--data", required=True,
-                   help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated LiDAR only], or train/ and "
-                        "val/ holding them")
+                   help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated LiDAR only], or train/ "
+                        "and val/ holding them")
     t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
                    "complete --model OUT)")
     t.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="PNG depth value per metre")

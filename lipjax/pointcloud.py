@@ -66,7 +66,8 @@ def backproject(depth_m: np.ndarray, intrinsics: IntrinsicsLike) -> np.ndarray:
     return np.stack([x, y, z], axis=1).astype(np.float32)
 
 
-def backproject_rgbd(depth_m: np.ndarray, rgb: np.ndarray, intrinsics: IntrinsicsLike) -> tuple[np.ndarray, np.ndarray]:
+def backproject_rgbd(depth_m: np.ndarray, rgb: np.ndarray,
+                     intrinsics: IntrinsicsLike) -> tuple[np.ndarray, np.ndarray]:
     """(points (N, 3) float32 metres, colours (N, 3) uint8) of the valid pixels; see `backproject`."""
     rgb = np.asarray(rgb)
     depth = np.asarray(depth_m)

@@ -7,7 +7,8 @@
   (it passes its arguments to one library function, where the logic lives and is tested);
 * the library never imports `experiments` (the shipped configs depend on the library, not the other way round);
 * a private name (`_x`) is imported only from a module of the importer's own package;
-* the layers of ARCHITECTURE.md: a module imports only modules of its own layer or of layers below it.
+* the layers of ARCHITECTURE.md: a module imports only modules of its own layer or of layers below it;
+* every line of Python in the repository under `MAX_COLUMNS` columns.
 """
 from __future__ import annotations
 
@@ -19,6 +20,8 @@ PACKAGE = ROOT / "lipjax"
 MAX_FUNCTION_LINES = 100
 MAX_CLI_LINES = 300
 MAX_COMMAND_LINES = 20
+MAX_COLUMNS = 120  # lines shorter than this
+PYTHON_FOLDERS = ("lipjax", "experiments", "benchmarks", "tests")
 
 # The layers of ARCHITECTURE.md, bottom up: module-name prefix -> layer. The longest matching prefix decides.
 LAYERS = {
@@ -165,6 +168,13 @@ def test_the_command_line_is_thin():
     long = [f"{f.name}: {f.end_lineno - f.lineno + 1} lines" for f in commands
             if f.end_lineno - f.lineno + 1 > MAX_COMMAND_LINES]
     assert long == []
+
+
+def test_every_line_is_under_the_column_limit():
+    long = [f"{path.relative_to(ROOT)}:{i}: {len(line)} columns"
+            for folder in PYTHON_FOLDERS for path in sorted((ROOT / folder).rglob("*.py"))
+            for i, line in enumerate(path.read_text().splitlines(), 1) if len(line) >= MAX_COLUMNS]
+    assert long == [], "\n".join(long)
 
 
 def test_library_never_imports_experiments():

@@ -352,8 +352,8 @@ def test_evaluate_own_folder_scores_its_sparse_maps_on_every_frame_without_intri
     assert result["num_images"] == 10 and result["metrics"]["rmse_m"] == pytest.approx(1.0, abs=1e-5)
     assert cli.main(args + ["--split", "val"]) == 0
     assert capsys.readouterr().out.splitlines()[0] == (
-        f"data: {tmp_path / 'mine'}, val split: the last 5 % of the frames, as lipjax train holds them out (1 frames), "
-        "sampler: input (the data's own sparse maps), depth range: (0, 10] m")
+        f"data: {tmp_path / 'mine'}, val split: the last 5 % of the frames, as lipjax train holds them out "
+        "(1 frames), sampler: input (the data's own sparse maps), depth range: (0, 10] m")
     assert cli.main(args + ["--sampler", "uniform:20"]) == 0  # samples of the ground truth: exact
     assert json.loads((tmp_path / "r.json").read_text())["nearest"]["metrics"]["rmse_m"] == pytest.approx(0, abs=1e-6)
     capsys.readouterr()

@@ -123,7 +123,8 @@ def test_nyu_h5_errors(tmp_path):
         NyuH5Dataset(tmp_path, "val")
 
 
-@pytest.mark.skipif(importlib.util.find_spec("tensorflow_datasets") is not None, reason="tensorflow_datasets installed")
+@pytest.mark.skipif(importlib.util.find_spec("tensorflow_datasets") is not None,
+                    reason="tensorflow_datasets installed")
 def test_nyu_tfds_missing_package_error():
     with pytest.raises(DatasetError, match=r"pip install lipjax\[tfds\]"):
         NyuTfdsDataset("val")

@@ -301,8 +301,8 @@ def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path, capsys):
     done = complete(model, tmp_path / "rgb.png", tmp_path / "sparse.npy", tmp_path / "out.npy")
     assert done.returncode == 0, done.stderr[-3000:]
     assert np.load(tmp_path / "out.npy").shape == (H, W)
-    assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none", "--model", str(model),
-                     "--limit", "2", "--quiet"]) == 0
+    assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none",
+                     "--model", str(model), "--limit", "2", "--quiet"]) == 0
     row = [line for line in capsys.readouterr().out.splitlines() if line.startswith(f"| {model} |")]
     assert len(row) == 1 and np.isfinite(float(row[0].split("|")[2]))
 
@@ -342,7 +342,8 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
     train = subprocess.run([sys.executable, "-m", "lipjax.cli", "train", "--data", str(root), "--out", str(model),
                             "--depth-scale", "1000", "--steps", "2", "--batch-size", "2", "--crop", "24", "32",
                             "--workers", "0", "--init", "lip-cnn-indoor",
-                            "--workdir", str(tmp_path / "run"), "--quiet"], capture_output=True, text=True, timeout=600)
+                            "--workdir", str(tmp_path / "run"), "--quiet"],
+                           capture_output=True, text=True, timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
                     "--depth-scale", "1000")
@@ -373,8 +374,8 @@ def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_a
     captured = capsys.readouterr()
     init, scene, why = default_init(root=str(root), depth_scale=1000.0)
     assert (init, scene) == (str(stem), "indoor")
-    assert captured.err.splitlines()[0] == f"init: {stem}, the default for indoor input ({why}); choose another with " \
-                                           "--init"
+    assert captured.err.splitlines()[0] == (f"init: {stem}, the default for indoor input ({why}); "
+                                            "choose another with --init")
     start, end = (logged_validation(tmp_path / "run" / "metrics.jsonl", step) for step in (0, 2))
     config = folder_config(CONFIG.model, str(stem), root=str(root), depth_scale=1000.0, crop=CROP, num_workers=0)
     want = loop.evaluate_params(CONFIG.model, model_io.load(stem)[1], loop.validation_batches(config), 10.0)
@@ -529,11 +530,13 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
     rendered = ["--source", "rendered", "--root", str(out)]
     for args, message in [(rendered + ["--size", "16", "24"], "--size is for --data synthetic-*"),
                           (rendered + ["--intrinsics", "1", "1", "0", "0"], "--intrinsics / --intrinsics-file"),
-                          (["--source", "synthetic", "--intrinsics-file", "K.txt"], "--intrinsics / --intrinsics-file"),
+                          (["--source", "synthetic", "--intrinsics-file", "K.txt"],
+                           "--intrinsics / --intrinsics-file"),
                           (["--source", "synthetic", "--split", "test"], "--split test: with --source"),
                           (rendered + ["--split", "val"], "--split: --source rendered evaluates the frames"),
                           (rendered + ["--kind", "outdoor"], "--kind goes with --source synthetic"),
-                          (["--data", "synthetic-indoor", "--kind", "outdoor"], "--kind goes with --source synthetic")]:
+                          (["--data", "synthetic-indoor", "--kind", "outdoor"],
+                           "--kind goes with --source synthetic")]:
         assert cli.main(base + args) == 1, args
         lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
         assert len(lines) == 1 and lines[0].startswith(f"lipjax: error: {message}"), lines

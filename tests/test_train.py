@@ -128,7 +128,8 @@ def test_non_finite_loss_stops_and_keeps_last_good_checkpoint(tmp_path, monkeypa
 def test_host_initial_estimate_reaches_the_train_step(tmp_path):
     """A model whose z_0 is computed on the host trains: the loop adds z0 to each batch after cropping."""
     model = dataclasses.replace(CONFIG.model, initial_estimate="nearest")
-    config = dataclasses.replace(CONFIG, name="host-init", model=model, g_steps=2, d_steps=0, adv_steps=0, eval_every=2)
+    config = dataclasses.replace(CONFIG, name="host-init", model=model, g_steps=2, d_steps=0, adv_steps=0,
+                                 eval_every=2)
     state = loop.train(config, tmp_path, progress=False)
     assert int(state.step) == 2
     rows = [json.loads(line) for line in (tmp_path / "metrics.jsonl").read_text().splitlines()]

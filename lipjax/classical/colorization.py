@@ -72,7 +72,8 @@ def nested_dissection_order(h: int, w: int, leaf_size: int = 64) -> np.ndarray:
     idx = np.arange(h * w).reshape(h, w)
     out: list[np.ndarray] = []
     stack = [(0, h, 0, w, False)]
-    # Explicit stack instead of recursion; a region is pushed again with emit_separator=True to emit its separator last.
+    # Explicit stack instead of recursion; a region is pushed again with emit_separator=True to emit its separator
+    # last.
     while stack:
         y0, y1, x0, x1, emit_separator = stack.pop()
         hh, ww = y1 - y0, x1 - x0

@@ -251,7 +251,8 @@ class KittiSelection(_KittiBase):
         for path in (root / "image").glob("*.png"):
             match = _SELECTION_NAME.match(path.stem)
             if match is None:
-                raise dataset_error("Unexpected file name in val_selection_cropped/image", path, KITTI_SELECTION_LAYOUT)
+                raise dataset_error("Unexpected file name in val_selection_cropped/image", path,
+                                    KITTI_SELECTION_LAYOUT)
             d, f, c = match["drive"], match["frame"], match["camera"]
             entries.append((natural_key(d), c, natural_key(f), d, f))
         if not entries:

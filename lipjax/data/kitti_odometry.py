@@ -51,7 +51,8 @@ class KittiOdometry:
     def __init__(self, root: str | os.PathLike, sequences: tuple[str, ...] | None = None):
         seq_root = Path(root) / "sequences"
         if not seq_root.is_dir():
-            raise dataset_error("KITTI odometry root not found", seq_root, KITTI_ODOMETRY_LAYOUT, KITTI_ODOMETRY_SOURCE)
+            raise dataset_error("KITTI odometry root not found", seq_root, KITTI_ODOMETRY_LAYOUT,
+                                KITTI_ODOMETRY_SOURCE)
         names = sequences or sorted((p.name for p in seq_root.iterdir() if (p / "velodyne").is_dir()), key=natural_key)
         self.frames: list[tuple[str, Path, Path]] = []
         self.calib: dict[str, tuple[Intrinsics, np.ndarray]] = {}

@@ -256,7 +256,8 @@ def open_source(data: Any, split: str, *, render_frames: bool = False) -> Source
         sampler = sampler_from_spec(spec)
     if protocol is not None:
         dataset = ProtocolView(dataset, protocol)
-    if split == "val" and data.source != "synthetic" and data.val_images is not None and len(dataset) > data.val_images:
+    if (split == "val" and data.source != "synthetic" and data.val_images is not None
+            and len(dataset) > data.val_images):
         dataset = Subset(dataset, np.arange(data.val_images))
     if len(dataset) == 0:
         raise ValueError(f"data.source={data.source!r} at {data.root}: the {split} split is empty")

@@ -65,7 +65,8 @@ class TartanAirDataset:
     """
 
     def __init__(self, root: str | os.PathLike, split: str = "train",
-                 difficulties: tuple[str, ...] = TARTANAIR_DIFFICULTIES, intrinsics: Intrinsics = TARTANAIR_INTRINSICS):
+                 difficulties: tuple[str, ...] = TARTANAIR_DIFFICULTIES,
+                 intrinsics: Intrinsics = TARTANAIR_INTRINSICS):
         root = Path(root)
         if split != "all" and split not in TARTANAIR_SPLIT_FRACTIONS:
             raise ValueError(f"TartanAir split must be one of {sorted(TARTANAIR_SPLIT_FRACTIONS)} or 'all', "

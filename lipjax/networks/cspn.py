@@ -41,7 +41,8 @@ def _neighbours(h: jax.Array) -> jax.Array:
     return jnp.stack([p[:, 1 + dy : 1 + dy + hh, 1 + dx : 1 + dx + ww] for dy, dx in NEIGHBOUR_OFFSETS], axis=-1)
 
 
-def propagate(h0: jax.Array, raw_affinity: jax.Array, sparse: jax.Array, mask: jax.Array, iterations: int) -> jax.Array:
+def propagate(h0: jax.Array, raw_affinity: jax.Array, sparse: jax.Array, mask: jax.Array,
+              iterations: int) -> jax.Array:
     r"""Convolutional spatial propagation with replacement (Cheng et al. 2018, eq. 1 and its depth-completion form).
 
     With kappa, centre = normalize_affinity(raw_affinity), m = mask, s = sparse:

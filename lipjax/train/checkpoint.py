@@ -85,7 +85,8 @@ class CheckpointManager:
     def save(self, step: int, state: Any, metadata: dict) -> None:
         tree = jax.tree_util.tree_map(to_host, flax.serialization.to_state_dict(state))
         self._manager.save(
-            step, args=ocp.args.Composite(state=ocp.args.PyTreeSave(tree), meta=ocp.args.JsonSave(metadata)), force=True
+            step, args=ocp.args.Composite(state=ocp.args.PyTreeSave(tree), meta=ocp.args.JsonSave(metadata)),
+            force=True,
         )
         self._manager.wait_until_finished()
 

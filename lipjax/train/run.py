@@ -94,7 +94,8 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     if export_only:
         manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
         if manager.latest_step() is None:
-            raise FileNotFoundError(f"no checkpoint in {manager.directory} to export; train first (drop --export-only)")
+            raise FileNotFoundError(f"no checkpoint in {manager.directory} to export; "
+                                    "train first (drop --export-only)")
         init = model_io.load(config.init_from)[1] if config.init_from else None
         state, _ = manager.restore(init_state(config, init))
         manager.close()
