@@ -8,7 +8,7 @@
 * the library never imports `experiments` (the shipped configs depend on the library, not the other way round);
 * a private name (`_x`) is imported only from a module of the importer's own package;
 * the layers of ARCHITECTURE.md: a module imports only modules of its own layer or of layers below it;
-* every line of Python in the repository under `MAX_COLUMNS` columns.
+* every line of Python in `PYTHON_FOLDERS` shorter than `MAX_COLUMNS` columns.
 """
 from __future__ import annotations
 
