@@ -67,6 +67,17 @@ def gradients(rgb: np.ndarray, depth: np.ndarray):
     return np.hypot(gx, gy), np.hypot(dx, dy), defined
 
 
+def log_depth_step(depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """(H, W) float32: |central difference of log D| per pixel, the larger of x and y, where both ends are valid
+    (0 elsewhere). A sharp step of s in log depth marks the pixel either side of it with s / 2."""
+    ok = valid & (depth > 0)
+    log_d = np.log(np.where(ok, depth, 1.0))
+    step = np.zeros(depth.shape, np.float32)
+    step[:, 1:-1] = np.where(ok[:, :-2] & ok[:, 2:], np.abs(log_d[:, 2:] - log_d[:, :-2]) / 2, 0)
+    step[1:-1, :] = np.maximum(step[1:-1, :], np.where(ok[:-2] & ok[2:], np.abs(log_d[2:] - log_d[:-2]) / 2, 0))
+    return step
+
+
 def frame_statistics(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> dict | None:
     g_i, g_d, defined = gradients(*_resized(rgb, depth, valid))
     if defined.sum() < 100:
@@ -122,8 +133,8 @@ def main(argv=None) -> None:
         sources[f"renders, streets, {n} textured"] = _textured(streets, n)
     sources.update(_real(os.path.abspath(args.realdata)))
     keys = ("density", "precision", "recall", "rho")
-    print(f"| frames | n | colour edge density | P(depth edge | colour edge) | P(colour edge | depth edge) | "
-          f"Spearman rho |\n|---|---|---|---|---|---|")
+    print("| frames | n | colour edge density | P(depth edge | colour edge) | P(colour edge | depth edge) | "
+          "Spearman rho |\n|---|---|---|---|---|---|")
     for name, frames in sources.items():
         stats = [s for s in (frame_statistics(*f) for f in frames) if s is not None]
         means = {k: np.nanmean([s[k] for s in stats]) for k in keys}

@@ -37,7 +37,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, gradients  # noqa: E402
+from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, gradients, log_depth_step  # noqa: E402
 from benchmarks.real_frames import GREY, frames_and_inputs  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
@@ -56,11 +56,7 @@ def pixel_classes(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> np.n
     """Per pixel 0 (depth edge), 1 (colour only) or 2 (flat), as the module docstring defines them."""
     ok = valid & (depth > 0)
     colour_gradient = gradients(rgb, np.where(ok, depth, 0))[0]
-    log_d = np.log(np.where(ok, depth, 1.0))
-    step = np.zeros(depth.shape, np.float32)  # |central difference of log D| along x or y, where both ends are valid
-    step[:, 1:-1] = np.where(ok[:, :-2] & ok[:, 2:], np.abs(log_d[:, 2:] - log_d[:, :-2]) / 2, 0)
-    step[1:-1, :] = np.maximum(step[1:-1, :], np.where(ok[:-2] & ok[2:], np.abs(log_d[2:] - log_d[:-2]) / 2, 0))
-    depth_near, colour_near = _near(step > DEPTH_EDGE), _near(colour_gradient > COLOUR_EDGE)
+    depth_near, colour_near = _near(log_depth_step(depth, valid) > DEPTH_EDGE), _near(colour_gradient > COLOUR_EDGE)
     return np.where(depth_near, 0, np.where(colour_near, 1, 2))
 
 

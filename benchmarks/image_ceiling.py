@@ -13,8 +13,9 @@ ratio to the Delaunay linear fill, default path at native size (`complete_frame`
     photograph   the frame's own image
     grey         uniform grey (GREY): the depth-only part of the prior
     edges        an image made from the ground truth, the renders' cleanest cue: light grey, with the depth edges
-                 (|d log D| > DEPTH_EDGE per pixel along x or y, on the ground truth with its holes filled by the
-                 nearest valid pixel) drawn dark, EDGE_WIDTH_PX wide: where the surfaces break, nothing else
+                 drawn dark (the pixels either side of a log-depth step: central difference over DEPTH_EDGE per
+                 pixel along x or y, both ends valid, as benchmarks/failure_look.py classes them): where the
+                 surfaces break, nothing else
     shading      an image from the ground truth: a grey, uniformly white world lit by one light from the
                  camera's upper left (LIGHT_DIR, camera frame), Lambertian: AMBIENT + (1 - AMBIENT) max(0, n . l),
                  n the normals of the back-projected ground truth (holes filled by the nearest valid pixel,
@@ -42,15 +43,15 @@ import numpy as np
 from scipy import ndimage
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.edge_statistics import DEPTH_EDGE  # noqa: E402
-from benchmarks.real_frames import GREY, INDOOR_POINTS, frames_and_inputs, rmse  # noqa: E402
+from benchmarks.edge_statistics import DEPTH_EDGE, log_depth_step  # noqa: E402
+from benchmarks.generalisation import ratios_to_linear  # noqa: E402
+from benchmarks.real_frames import GREY, INDOOR_POINTS, frames_and_inputs  # noqa: E402
+from lipjax.classical import nearest_fill  # noqa: E402
 from lipjax.data.sampling import UniformSampler  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_frame  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 MEAN_SHIFT_SP, MEAN_SHIFT_SR = 12, 24  # cv2.pyrMeanShiftFiltering's spatial (px) and colour (0-255) windows
-EDGE_WIDTH_PX = 2
 EDGE_GREY, BACKGROUND_GREY = 40, 200
 LIGHT_DIR = (-0.4, -0.6, -0.7)  # towards the light, camera frame (x right, y down, z forward); normalised
 AMBIENT = 0.25
@@ -58,19 +59,9 @@ NORMAL_BLUR_PX = 2.0  # Gaussian sigma on the back-projected points before the n
 VARIANTS = ("photograph", "grey", "edges", "shading", "both", "flattened")
 
 
-def _nearest_valid(a: np.ndarray, missing: np.ndarray) -> np.ndarray:
-    idx = ndimage.distance_transform_edt(missing, return_distances=False, return_indices=True)
-    return a[tuple(idx)]
-
-
 def depth_edges(depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """(H, W) bool: pixels beside a log-depth step over DEPTH_EDGE along x or y, EDGE_WIDTH_PX wide."""
-    ok = valid & (depth > 0)
-    log_d = np.log(_nearest_valid(np.where(ok, depth, 1.0), ~ok))
-    edge = np.zeros(depth.shape, bool)
-    edge[:, :-1] |= np.abs(np.diff(log_d, axis=1)) > DEPTH_EDGE
-    edge[:-1, :] |= np.abs(np.diff(log_d, axis=0)) > DEPTH_EDGE
-    return cv2.dilate(edge.astype(np.uint8), np.ones((EDGE_WIDTH_PX,) * 2, np.uint8)).astype(bool)
+    """(H, W) bool: the pixels either side of a log-depth step over DEPTH_EDGE per pixel along x or y."""
+    return log_depth_step(depth, valid) > DEPTH_EDGE
 
 
 def _grey_rgb(grey: np.ndarray) -> np.ndarray:
@@ -80,7 +71,7 @@ def _grey_rgb(grey: np.ndarray) -> np.ndarray:
 def shading_image(depth: np.ndarray, valid: np.ndarray, intrinsics) -> np.ndarray:
     """(H, W, 3) uint8: the ground truth's surfaces, white and Lambertian under one light (module docstring)."""
     ok = valid & (depth > 0)
-    z = ndimage.gaussian_filter(_nearest_valid(np.where(ok, depth, 0.0), ~ok), NORMAL_BLUR_PX)
+    z = ndimage.gaussian_filter(nearest_fill(np.where(ok, depth, 0.0)).astype(np.float64), NORMAL_BLUR_PX)
     v, u = np.mgrid[:depth.shape[0], :depth.shape[1]]
     points = np.stack([(u - intrinsics.cx) / intrinsics.fx * z, (v - intrinsics.cy) / intrinsics.fy * z, z], -1)
     normal = np.cross(np.gradient(points, axis=1), np.gradient(points, axis=0))
@@ -128,11 +119,9 @@ def main(argv=None) -> None:
     frames += [("renders", s, UniformSampler(INDOOR_POINTS)(s, 0)) for s in renders]
     linear, rows = get_completer("linear"), []
     for group, sample, sparse in frames:
-        completer = get_completer(args.model, sparse=sparse)
-        reference = rmse(linear(sample.rgb, sparse), sample, sparse)
-        row = {"group": group, "frame": sample.id}
-        for v in variants:
-            row[v] = rmse(complete_frame(completer, variant_image(sample, v), sparse), sample, sparse) / reference
+        ratios = ratios_to_linear(args.model, linear, sample, lambda s, _, sparse=sparse: sparse,
+                                  [variant_image(sample, v) for v in variants])
+        row = {"group": group, "frame": sample.id, **dict(zip(variants, ratios))}
         rows.append(row)
         print(f"{sample.id:34s} " + "  ".join(f"{v} {row[v]:.3f}" for v in variants), flush=True)
     others = [v for v in variants if v != "grey"]

@@ -21,7 +21,6 @@ the core count, other processes share the cores). Times are medians over --repea
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import os
 import statistics
 import sys

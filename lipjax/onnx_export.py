@@ -49,7 +49,6 @@ import pathlib
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
