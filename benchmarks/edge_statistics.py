@@ -16,6 +16,8 @@ and per frame kind it prints, over pixels where the depth gradient is defined:
     precision                P(depth edge near | colour edge): how often a colour edge is a depth edge
     recall                   P(colour edge near | depth edge): how often a depth edge shows in the image
     rank correlation         Spearman's rho of |grad I| and |grad log D|
+    depth-edge density       P(depth edge) after a DEPTH_MEDIAN_PX median filter of D: real sensors' noise out,
+                             so that it counts geometry (is a real room more broken up than a rendered one?)
 `--texture N,...` adds rows for the renders with 1-N textured rectangles painted as training paints them
 (lipjax.data.augment.paint_texture at strength TEXTURE_STRENGTH, exactly N per frame, seeded by the frame's index).
 The renders' numbers against the photographs' tell which shortcut the prox can learn from renders that photographs
@@ -42,6 +44,7 @@ BLUR_PX = 1.0  # Gaussian blur of the grey image, pixels
 COLOUR_EDGE = 0.04  # grey-level change per pixel (of full scale 1) that counts as a colour edge
 DEPTH_EDGE = 0.05  # log-depth change per pixel (5 %) that counts as a depth edge
 NEAR_PX = 1
+DEPTH_MEDIAN_PX = 5  # median filter on D before the depth-edge density (cv2.medianBlur on float32 takes 3 or 5)
 TEXTURE_STRENGTH = 0.7  # lip_any's texture_strength (experiments/configs/base.py)
 
 
@@ -79,7 +82,8 @@ def log_depth_step(depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
 
 
 def frame_statistics(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> dict | None:
-    g_i, g_d, defined = gradients(*_resized(rgb, depth, valid))
+    rgb, depth = _resized(rgb, depth, valid)
+    g_i, g_d, defined = gradients(rgb, depth)
     if defined.sum() < 100:
         return None
     kernel = np.ones((2 * NEAR_PX + 1,) * 2, np.uint8)
@@ -87,12 +91,14 @@ def frame_statistics(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> d
     depth_edge = (g_d > DEPTH_EDGE) & defined
     colour_near = cv2.dilate(colour.astype(np.uint8), kernel).astype(bool)
     depth_near = cv2.dilate(depth_edge.astype(np.uint8), kernel).astype(bool)
+    _, g_smooth, defined_smooth = gradients(rgb, cv2.medianBlur(depth, DEPTH_MEDIAN_PX) * (depth > 0))
     nan = float("nan")
     return {
         "density": float(colour.sum() / defined.sum()),
         "precision": float((depth_near & colour).sum() / colour.sum()) if colour.any() else nan,
         "recall": float((colour_near & depth_edge).sum() / depth_edge.sum()) if depth_edge.any() else nan,
         "rho": float(spearmanr(g_i[defined], g_d[defined])[0]),
+        "depth_density": float(((g_smooth > DEPTH_EDGE) & defined_smooth).sum() / max(defined_smooth.sum(), 1)),
     }
 
 
@@ -132,9 +138,9 @@ def main(argv=None) -> None:
         sources[f"renders, rooms, {n} textured"] = _textured(rooms, n)
         sources[f"renders, streets, {n} textured"] = _textured(streets, n)
     sources.update(_real(os.path.abspath(args.realdata)))
-    keys = ("density", "precision", "recall", "rho")
+    keys = ("density", "precision", "recall", "rho", "depth_density")
     print("| frames | n | colour edge density | P(depth edge | colour edge) | P(colour edge | depth edge) | "
-          "Spearman rho |\n|---|---|---|---|---|---|")
+          "Spearman rho | depth-edge density (median-filtered D) |\n|---|---|---|---|---|---|---|")
     for name, frames in sources.items():
         stats = [s for s in (frame_statistics(*f) for f in frames) if s is not None]
         means = {k: np.nanmean([s[k] for s in stats]) for k in keys}
