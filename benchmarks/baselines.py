@@ -47,8 +47,8 @@ from lipjax.classical.lip_wavelet import LIPWavelet  # noqa: E402
 from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
 
-INDOOR_RANGE_M = (0.0, 10.0)
-OUTDOOR_RANGE_M = (0.0, 80.0)
+INDOOR_RANGE_M = (0.0, protocols.EVAL_MAX_DEPTH_INDOOR_M)
+OUTDOOR_RANGE_M = (0.0, protocols.EVAL_MAX_DEPTH_OUTDOOR_M)
 
 def _rgb(path: str) -> np.ndarray:
     bgr = cv2.imread(path, cv2.IMREAD_COLOR)

@@ -39,6 +39,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from benchmarks.failure_look import pixel_classes  # noqa: E402
 from benchmarks.generalisation import frames, ratios_to_linear  # noqa: E402
+from benchmarks.real_frames import GREY  # noqa: E402
 from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
@@ -129,7 +130,7 @@ def main(argv=None) -> None:
             nuisance = NUISANCES[name]
             seeds = [zlib.crc32(f"{s.id}/{name}".encode()) for s in clean]
             spoilt = [nuisance(s, np.random.default_rng(seed)) for s, seed in zip(clean, seeds)]
-            image, grey = zip(*(ratios_to_linear(args.model, linear, s, spec, (s.rgb, np.full_like(s.rgb, 128)))
+            image, grey = zip(*(ratios_to_linear(args.model, linear, s, spec, (s.rgb, np.full_like(s.rgb, GREY)))
                                 for s in spoilt))
             print(f"| {scene} | {name} | {geomean(image):.3f} | {geomean(grey):.3f} | "
                   f"{geomean(grey) / geomean(image):.3f} | {sum(r < 1 for r in image)}/{len(image)} |", flush=True)

@@ -31,15 +31,12 @@ from scipy.stats import spearmanr
 
 sys.path.insert(0, os.path.dirname(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from baselines import load_kitti, load_middlebury, load_nyu  # noqa: E402  (real frames, read in place)
+from baselines import INDOOR_RANGE_M, OUTDOOR_RANGE_M, load_kitti, load_middlebury, load_nyu  # noqa: E402
 from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
 from lipjax import uncertainty  # noqa: E402
 from lipjax.data import protocols  # noqa: E402
 from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
-
-INDOOR_RANGE_M = (0.0, 10.0)
-OUTDOOR_RANGE_M = (0.0, 80.0)
 
 
 def synthetic_settings(split: str, limit: int):

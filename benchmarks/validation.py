@@ -5,7 +5,7 @@ Run by hand (not a test):
     .venv/bin/python benchmarks/validation.py --scene indoor    # 32 val frames 256x320, uniform:200
     .venv/bin/python benchmarks/validation.py --scene outdoor   # 32 val frames 128x416, lidar:hdl64
 
-The frames, sizes and sampler are those of the scene's training config (experiments/configs.py, `data.val_*`),
+The frames, sizes and sampler are those of the scene's training config (experiments/configs/, `data.val_*`),
 so this is the table behind "the shipped weights beat LIP+Wavelet and every classical baseline on the synthetic
 validation split". Metrics per image over valid ground truth in the scene protocol's depth range (indoor
 (0, 10] m, outdoor (0, 80] m), then averaged; sampler seed 0. Prints a Markdown table.

@@ -4,7 +4,6 @@ Experiments stay thin: they build a config, pick a data set, a protocol and a sa
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import pathlib
 import platform
@@ -116,10 +115,6 @@ def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inp
                              {name: np.asarray(completers[name](sample.rgb, sparse)) for name in shown}, sample.valid)
               for sample, sparse in zip(samples, sparse_inputs)]
     viz.save_comparison_grid(path, frames, max_depth_m, max_error_m, sparse_title=sparse_title)
-
-
-def config_fields(config) -> dict[str, Any]:
-    return {f.name: getattr(config, f.name) for f in dataclasses.fields(config)}
 
 
 def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequence[float]], *, xlabel: str,

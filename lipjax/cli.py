@@ -28,19 +28,18 @@ from lipjax.data.folder import parse_depth_scale
 from lipjax.data.protocols import PROTOCOLS
 from lipjax.data.rendered import render_to_disk
 from lipjax.data.sources import NO_PROTOCOL, SOURCES
+from lipjax.data.synthetic import SYNTHETIC_KINDS
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate_methods, markdown_table, save_json
 from lipjax.export import export
 from lipjax.files import COMPLETE_HELP, READ_WORKERS, complete_files, project_file
+from lipjax.methods import CLASSICAL
 from lipjax.model_io import listing
+from lipjax.train.folder import FOLDER_BATCH_SIZE, FOLDER_DATA, FOLDER_STEPS
 from lipjax.train.run import fine_tune_folder
 from lipjax.utils import enable_compilation_cache, limit_cpu_threads
 
 PROG = "lipjax"
 _RAW = argparse.RawDescriptionHelpFormatter
-
-
-def _say(line: str) -> None:
-    print(line, file=sys.stderr)
 
 
 def _depth_scale(text: str) -> float:
@@ -59,9 +58,9 @@ def _cmd_complete(args) -> int:
         out_format=args.out_format, color_range=args.color_range, ply=args.ply,
         intrinsics=args.intrinsics or args.intrinsics_file, uncertainty=args.uncertainty,
         max_uncertainty=args.max_uncertainty, fill_all=args.fill_all, progress=not args.quiet,
-        log=None if args.quiet else _say, workers=min(args.threads or READ_WORKERS, READ_WORKERS))
+        log=None if args.quiet else console.say, workers=min(args.threads or READ_WORKERS, READ_WORKERS))
     if not args.quiet:
-        _say(done.summary())
+        console.say(done.summary())
     return 0
 
 
@@ -69,7 +68,7 @@ def _cmd_project(args) -> int:
     written = project_file(args.rgb, args.lidar, args.calib, args.out, camera=args.camera,
                            depth_scale=args.depth_scale)
     if not args.quiet:
-        _say(written.summary())
+        console.say(written.summary())
     return 0
 
 
@@ -95,7 +94,7 @@ def _cmd_export(args) -> int:
     except ImportError as exc:  # the optional flatbuffers / onnx packages
         raise console.UserError(str(exc)) from exc
     if not args.quiet:
-        _say(written.summary())
+        console.say(written.summary())
     return 0
 
 
@@ -104,7 +103,8 @@ def _cmd_data_render(args) -> int:
         out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
                              window=args.window, workers=args.workers, progress=not args.quiet)
     except (KeyboardInterrupt, SystemExit) as stop:  # Ctrl-C, SIGTERM: the workers are stopped already
-        _say(f"{PROG}: render stopped; its finished shards stay in {args.out}, and the same command finishes it")
+        console.say(f"{PROG}: render stopped; its finished shards stay in {args.out}, "
+                    "and the same command finishes it")
         return 130 if isinstance(stop, KeyboardInterrupt) else stop.code
     print(f"rendered {args.count} {args.kind}/{args.split} frames to {out}")
     return 0
@@ -112,7 +112,7 @@ def _cmd_data_render(args) -> int:
 
 def _cmd_train(args) -> int:
     fine_tune_folder(args.data, args.out, init=args.init, steps=args.steps, batch_size=args.batch_size,
-                     workdir=args.workdir, progress=not args.quiet, log=None if args.quiet else _say,
+                     workdir=args.workdir, progress=not args.quiet, log=None if args.quiet else console.say,
                      depth_scale=args.depth_scale, num_workers=args.workers, crop=args.crop and tuple(args.crop),
                      train_sampler=args.sampler)
     return 0
@@ -148,8 +148,7 @@ def _add_complete_parser(sub) -> None:
     _add_lidar_args(c, required=False)
     c.add_argument("--depth-scale", type=_depth_scale, metavar="S",
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also of .png output (default 256)")
-    _add_model_args(c, "shipped model name (lipjax models) or saved model path (also a classical fill: nearest, "
-                       "linear, ip_basic, colorization, lip-wavelet)")
+    _add_model_args(c, f"shipped model (lipjax models), saved model path or classical fill ({', '.join(CLASSICAL)})")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=("npy", "png", "color.png"), help="per-frame format with folder inputs")
     c.add_argument("--max-side", type=console.positive_int, metavar="N",
@@ -186,8 +185,8 @@ def _add_evaluate_parser(sub) -> None:
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
                        "data source (Markdown table)")
     e.add_argument("--model", "--method", dest="model", action="append",
-                   help="shipped model, saved model path, or a classical fill (nearest, linear, ip_basic, "
-                        "colorization, lip-wavelet); repeat to compare (default: the default model of the input)")
+                   help=f"shipped model, saved model path, or a classical fill ({', '.join(CLASSICAL)}); repeat "
+                        "to compare (default: the default model of the input)")
     e.add_argument("--iterations", type=console.positive_int, metavar="K")
     data = e.add_mutually_exclusive_group()
     data.add_argument("--data", help="synthetic-indoor (default) | synthetic-outdoor | FOLDER with rgb/ depth/ "
@@ -199,7 +198,7 @@ def _add_evaluate_parser(sub) -> None:
     e.add_argument("--raw-root", metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", choices=("train", "val", "test"), help="synthetic split (default test); FOLDER: "
                    "train or val as lipjax train splits it (default: every frame); --source: train|val (default val)")
-    e.add_argument("--kind", choices=("indoor", "outdoor"), help="the scenes of --source synthetic (default indoor)")
+    e.add_argument("--kind", choices=SYNTHETIC_KINDS, help="the scenes of --source synthetic (default indoor)")
     e.add_argument("--size", type=console.positive_int, nargs=2, metavar=("H", "W"), help="synthetic: default 256 320")
     e.add_argument("--sampler", help="sparse input spec, e.g. uniform:200, bernoulli:500, lidar:hdl64, or input[:N], "
                    "the data's own sparse input (a FOLDER's sparse/, KITTI's scan). Default: input for a FOLDER with "
@@ -209,7 +208,7 @@ def _add_evaluate_parser(sub) -> None:
     e.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="of PNG depth in FOLDER (or --source folder)")
     _add_intrinsics_args(e)
     e.add_argument("--min-depth-m", type=float)
-    e.add_argument("--max-depth-m", type=float, help="default: the protocol's (10 indoor, 80 outdoor)")
+    e.add_argument("--max-depth-m", type=float, help="default: the protocol's (10 indoor, 80 outdoor; FOLDER: none)")
     e.add_argument("--limit", type=console.positive_int, metavar="N", help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", help=f"comma-separated metric names (default: {','.join(DEFAULT_COLUMNS)})")
@@ -236,7 +235,7 @@ def _add_data_parser(sub) -> None:
     d = sub.add_parser("data", help="data sets: `lipjax data render` writes the synthetic scenes to disk")
     r = d.add_subparsers(dest="data_command", required=True, metavar="ACTION").add_parser(
         "render", help="render synthetic frames into shard files, in worker processes")
-    r.add_argument("--kind", required=True, choices=("indoor", "outdoor"))
+    r.add_argument("--kind", required=True, choices=SYNTHETIC_KINDS)
     r.add_argument("--split", default="train", choices=("train", "val", "test"))
     r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
     r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
@@ -259,12 +258,13 @@ def _add_train_parser(sub) -> None:
     t.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", help="model to start from: shipped name or saved path (default: the "
                    "default model of the frames' scene, as lipjax complete picks it)")
-    t.add_argument("--steps", type=console.positive_int, help="training steps (default 2000)")
-    t.add_argument("--batch-size", type=console.positive_int, default=8)
+    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {FOLDER_STEPS})")
+    t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {FOLDER_BATCH_SIZE})")
     t.add_argument("--sampler", help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps")
-    t.add_argument("--crop", type=console.positive_int, nargs=2, metavar=("H", "W"), help="default 128 160")
-    t.add_argument("--workers", type=int, default=2, help="loader worker processes (0: none)")
+    t.add_argument("--crop", type=console.positive_int, nargs=2, metavar=("H", "W"),
+                   help=f"random training crops (default {' '.join(map(str, FOLDER_DATA.crop))})")
+    t.add_argument("--workers", type=int, help=f"loader worker processes (0: none; default {FOLDER_DATA.num_workers})")
     t.add_argument("--workdir", help="checkpoints and logs (default runs/train-<--out name>)")
     t.add_argument("--quiet", action="store_true")
     t.set_defaults(func=_cmd_train)

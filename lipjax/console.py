@@ -59,6 +59,11 @@ def one_line(exc: BaseException) -> str:
     return " | ".join(lines)
 
 
+def say(line: str) -> None:
+    """A status line for the user, on stderr (stdout stays for results)."""
+    print(line, file=sys.stderr)
+
+
 def warn(prog: str, message: str) -> None:
     print(f"{prog}: warning: {message}", file=sys.stderr)
 

@@ -16,7 +16,7 @@ source) in one place; `evaluate_methods` scores every method on it.
 Protocol, in one place:
   - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
     sample id and this seed, so every method sees the same inputs and reruns are identical;
-  - metrics are per image over valid ground truth within [min_depth_m, max_depth_m], then averaged over images
+  - metrics are per image over valid ground truth in (min_depth_m, max_depth_m], then averaged over images
     (see lipjax.metrics);
   - time per frame is the wall-clock time of the completer call alone (sampling and metrics excluded), including
     the conversion of its output to numpy, which waits for asynchronous JAX computations to finish. The first
@@ -41,6 +41,7 @@ import numpy as np
 from lipjax.interfaces import DepthCompleter
 from lipjax.data.protocols import Protocol
 from lipjax.data.sample import Sample
+from lipjax.data.sampling import DEFAULT_SAMPLER
 from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol
 from lipjax.methods import get_completer
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
@@ -104,7 +105,7 @@ def open_eval_source(
     root: str | os.PathLike | None,
     split: str = "val",
     *,
-    sampler: str = "uniform:200",
+    sampler: str = DEFAULT_SAMPLER,
     protocol: str | None = None,
     raw_root: str | os.PathLike | None = None,
     depth_scale: float | None = None,
@@ -150,9 +151,6 @@ def open_eval_source(
                       depth_scale=depth_scale, train_sampler=sampler, val_sampler=sampler, val_images=None,
                       kind=kind, height=height, width=width)
     return open_source(data, split, render_frames=True), range_protocol(data)
-
-
-DEFAULT_SAMPLER = "uniform:200"  # the sparse input where the data have none of their own (the paper's Table I)
 
 
 def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: str | None = None,

@@ -39,8 +39,8 @@ from typing import Any
 import numpy as np
 
 from lipjax import inference
-from lipjax.data.folder import (check_one_depth_format, output_format, pair_frames, read_frame, read_intrinsics,
-                                write_depth)
+from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, output_format, pair_frames, read_frame,
+                                read_intrinsics, write_depth)
 from lipjax.data.lidar import read_lidar_frame
 from lipjax.data.sample import Intrinsics
 from lipjax.inference import Completer, complete_frame, frame_size
@@ -51,7 +51,7 @@ from lipjax.pointcloud import IntrinsicsLike, backproject_rgbd, write_ply
 from lipjax.uncertainty import drop_uncertain, expected_error, support_mask, write_uncertainty
 from lipjax.viz import fitting_range
 
-DEFAULT_PNG_OUT_SCALE = 256.0
+DEFAULT_PNG_OUT_SCALE = KNOWN_DEPTH_SCALES["kitti"]
 """PNG value per metre of .png output when no depth scale was given (KITTI's)."""
 COMPLETE_HELP = """\
   --rgb     colour image (.png / .jpg), or a folder of them.

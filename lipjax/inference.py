@@ -30,7 +30,7 @@ from lipjax.zbuffer import splat_nearest
 
 
 @functools.lru_cache(maxsize=None)
-def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
+def compiled_apply(config: LearnedModel, return_trajectory: bool = False):
     """jit(config.apply) as (params, rgb, sparse, extra) -> (depth, trajectory or None); extra holds the
     host-computed inputs (`config.host_inputs(sparse)`), e.g. {"z0": ...}, or is empty."""
 
@@ -42,7 +42,8 @@ def compiled_apply(config: LIPConfig, return_trajectory: bool = False):
 
 @dataclasses.dataclass(frozen=True, eq=False)
 class Completer:
-    """A LIP model with its parameters, callable on images. Build with `load_model` or `Completer.random`."""
+    """A learned model (any `LearnedModel`) with its parameters, callable on images. Built by `load_model` or
+    `Completer.random`."""
 
     config: LearnedModel  # a LIPConfig or an end-to-end network's config (lipjax.interfaces)
     params: Any
@@ -57,21 +58,8 @@ class Completer:
 
     def with_iterations(self, num_iterations: int) -> "Completer":
         """The same model run for fewer iterations (uses the first K of its per-iteration operators)."""
-        if not self.config.iterative:
-            raise ValueError(f"{self.name} is an end-to-end network, not an iterative LIP model: it has no iterations")
-        if num_iterations == self.config.num_iterations:
-            return self
-        if num_iterations < 1 or (num_iterations > self.config.num_iterations and not self.config.shared_prox):
-            raise ValueError(f"this model has {self.config.num_iterations} iterations; got {num_iterations}")
-        config = dataclasses.replace(self.config, num_iterations=num_iterations)
-        params = dict(self.params)
-        if not self.config.shared_prox:
-            params["prox"] = jax.tree_util.tree_map(lambda a: a[:num_iterations], params["prox"])
-        if "log_rho" in params:
-            log_rho = np.asarray(params["log_rho"])
-            params["log_rho"] = (np.resize(log_rho, num_iterations) if self.config.shared_prox
-                                 else log_rho[:num_iterations])
-        return Completer(config, params, self.name, self.metadata)
+        config, params = self.config.with_iterations(self.params, num_iterations)
+        return self if config is self.config else Completer(config, params, self.name, self.metadata)
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
         """Dense depth in metres, (H, W) or (B, H, W) like the input."""

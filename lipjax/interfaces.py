@@ -106,6 +106,11 @@ class LearnedModel(abc.ABC):
         """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse metres; none by default."""
         return {}
 
+    def with_iterations(self, params: Params, num_iterations: int) -> tuple["LearnedModel", Params]:
+        """(config, params) of the same model run for `num_iterations` iterations; iterative models only."""
+        raise ValueError(f"{type(self).__name__} is an end-to-end network: it has no iterations to choose "
+                         "(--iterations is for LIP models)")
+
 
 @runtime_checkable
 class DepthCompleter(Protocol):
@@ -113,10 +118,11 @@ class DepthCompleter(Protocol):
 
         completer(rgb: (H, W, 3) uint8, sparse: (H, W) float32 metres, 0 = no sample) -> (H, W) float32 metres
 
-    with a `name` (the row label of result tables). The classical fills (lipjax.classical), LIP+Wavelet, a loaded
+    with a `name` (the row label of result tables). The classical fills (lipjax.classical), LIP+Wavelet and a loaded
     learned model (`lipjax.inference.Completer`: LIP or an end-to-end network, also taking batches, with its
-    `parameter_count()` and its config's `max_depth_m`) and an exported model (`lipjax.export.ExportedCompleter`) are
-    completers; `lipjax.methods.get_completer` builds any of them by name. Inputs are checked by lipjax.inputs.
+    `parameter_count()` and its config's `max_depth_m`) are completers; `lipjax.methods.get_completer` builds any of
+    them by name or path. Inputs are checked by lipjax.inputs. (A StableHLO export, `lipjax.export.load_exported`,
+    is not one: it takes batches of the one size it was exported at, as a deployed graph does.)
     """
 
     name: str

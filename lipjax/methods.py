@@ -39,8 +39,6 @@ from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
 from lipjax.uncertainty import drop_uncertain, expected_error
 
-SCENES = ("indoor", "outdoor")
-
 # Methods without learned parameters, by name: their factories take the method's settings as keyword arguments.
 CLASSICAL: dict[str, Callable[..., DepthCompleter]] = {
     "nearest": NearestFill,

@@ -71,7 +71,6 @@ ERROR_METRICS = (
     "mae_all_m",
 )
 SAMPLED_METRICS = ("mae_sampled_m", "mae_unsampled_m", "mae_vs_input_m")
-COUNT_KEYS = ("n_eval_px", "n_sampled_eval_px", "n_input_px")
 METRIC_NAMES = ERROR_METRICS + SAMPLED_METRICS
 
 

@@ -63,7 +63,7 @@ class LIPConfig(LearnedModel):
         prox's estimate with the measurements re-imposed (the shipped outdoor models). Measured pixels keep the
         x-update's guarantee either way; on the others "x" reads 2 z_K - x_K - u_{K-1}, which extrapolates the
         last prox's step and can cross zero where that step is large. With a log-depth prox
-        (NetworkPrior.depth_domain="log") "z" makes depth <= 0 impossible; see experiments/configs.py.
+        (NetworkPrior.depth_domain="log") "z" makes depth <= 0 impossible; see experiments/configs/.
     """
 
     prior: Any = dataclasses.field(default_factory=lambda: network_preset("small"))
@@ -97,6 +97,21 @@ class LIPConfig(LearnedModel):
         if not self.needs_host_initial_estimate:
             return {}
         return {"z0": host_initial_estimate(self.initial_estimate, sparse)}
+
+    def with_iterations(self, params, num_iterations: int) -> tuple["LIPConfig", Any]:
+        """(config, params) for the first K = num_iterations iterations: the first K per-iteration proxes and rho_k
+        (a shared prox also runs for more than it trained with, repeating its rho)."""
+        if num_iterations == self.num_iterations:
+            return self, params
+        if num_iterations < 1 or (num_iterations > self.num_iterations and not self.shared_prox):
+            raise ValueError(f"this model has {self.num_iterations} iterations; got {num_iterations}")
+        params = dict(params)
+        if not self.shared_prox:
+            params["prox"] = jax.tree_util.tree_map(lambda a: a[:num_iterations], params["prox"])
+        if "log_rho" in params:
+            log_rho = np.asarray(params["log_rho"])
+            params["log_rho"] = np.resize(log_rho, num_iterations) if self.shared_prox else log_rho[:num_iterations]
+        return dataclasses.replace(self, num_iterations=num_iterations), params
 
     def parameter_count(self, params) -> int:
         """Learned network parameters (the prox networks of all iterations and a shared encoder; rho excluded)."""

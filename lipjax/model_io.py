@@ -1,4 +1,5 @@
-"""Saving and loading a trained LIP model: a config (JSON) and parameters (flax msgpack). No pickle.
+"""Saving and loading a trained model (LIP or an end-to-end network): a config (JSON) and parameters (flax
+msgpack). No pickle.
 
 A model on disk is two files side by side: `<stem>.json` (the model config, with its type and its prior's type named)
 and `<stem>.msgpack` (the parameter pytree, `flax.serialization.msgpack_serialize`). Models shipped with the package
@@ -20,6 +21,7 @@ import flax.serialization
 import jax
 import numpy as np
 
+from lipjax.inputs import OUTDOOR_MEDIAN_M
 from lipjax.interfaces import MODEL_TYPES, PRIOR_TYPES, model_type_name
 from lipjax.model import LIPConfig
 import lipjax.priors.guided  # noqa: F401  (registers the prior types model files name)
@@ -161,7 +163,8 @@ def listing() -> str:
         return (f"no shipped models in {WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. Train one "
                 "with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
     return (table(DEFAULT_MODELS) + "\n\nDEFAULT: the inputs lipjax complete gives the model (indoor: scattered "
-            "samples; outdoor: LiDAR scan lines\nor a median sample depth over 12 m); --model NAME overrides it. "
+            "samples; outdoor: LiDAR scan lines\nor a median sample depth over "
+            f"{OUTDOOR_MEDIAN_M:g} m); --model NAME overrides it. "
             "TYPE: LIP and its prox, or an end-to-end network.")
 
 

@@ -177,12 +177,12 @@ def test_every_line_is_under_the_column_limit():
     assert long == [], "\n".join(long)
 
 
-def test_library_never_imports_experiments():
+def test_library_never_imports_experiments_or_benchmarks():
     found = []
     for path in sorted(PACKAGE.rglob("*.py")):
         tree = ast.parse(path.read_text(), str(path))
         names = [n for node in ast.walk(tree) for n in _imported(_module_name(path), path, node, {})]
-        found += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] == "experiments"]
+        found += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] in ("experiments", "benchmarks")]
     assert found == []
 
 

@@ -17,11 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from lipjax.data.errors import dataset_error
-from lipjax.data.folder import natural_key, read_depth, read_intrinsics_txt, read_rgb
+from lipjax.data.folder import KNOWN_DEPTH_SCALES, natural_key, read_depth, read_intrinsics_txt, read_rgb
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import example_rng, subsample_exact
 
-KITTI_DEPTH_SCALE = 256.0  # PNG value per metre
 KITTI_CAMERAS = ("image_02", "image_03")  # left / right colour cameras
 
 KITTI_DC_LAYOUT = """\
@@ -48,7 +47,7 @@ KITTI_SELECTION_SOURCE = (
 
 def read_kitti_depth(path: str | os.PathLike) -> np.ndarray:
     """Reads a KITTI 16-bit depth PNG -> (H, W) float32 metres (value / 256), 0 = no measurement."""
-    return read_depth(path, KITTI_DEPTH_SCALE)
+    return read_depth(path, KNOWN_DEPTH_SCALES["kitti"])
 
 
 def read_calib_cam_to_cam(path: str | os.PathLike) -> dict[str, np.ndarray]:

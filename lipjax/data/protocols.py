@@ -181,7 +181,6 @@ class Protocol:
 
 
 # The NYU paper crop: see the module docstring for why 464x580 (aspect 0.8, drops the white border).
-NYU_RAW_SIZE = (480, 640)
 NYU_PAPER_CROP = (464, 580)
 PAPER_SIZE = (256, 320)
 EVAL_MAX_DEPTH_INDOOR_M = 10.0
@@ -215,7 +214,6 @@ SYNTHETIC_OUTDOOR = Protocol(
     "synthetic_outdoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "Embedded procedural outdoor scenes, rendered at 256x320 (identity).",
 )
-SYNTHETIC = SYNTHETIC_INDOOR
 
 PROTOCOLS: dict[str, Protocol] = {
     p.name: p

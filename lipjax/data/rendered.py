@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from lipjax.data.errors import dataset_error
+from lipjax.data.folder import KNOWN_DEPTH_SCALES
 from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import example_rng
 from lipjax.utils import die_with_parent
@@ -46,7 +47,7 @@ INDEX = "index.json"
 # Full-frame size per kind, as the shipped training configs render them (experiments/configs/base.py).
 TRAINING_SIZES = {"indoor": (256, 320), "outdoor": (128, 416)}
 # uint16 depth: value per metre. Indoor 1 mm steps up to 65.5 m; outdoor KITTI's 1/256 m up to 256 m.
-DEPTH_SCALES = {"indoor": 1000.0, "outdoor": 256.0}
+DEPTH_SCALES = {"indoor": KNOWN_DEPTH_SCALES["nyu"], "outdoor": KNOWN_DEPTH_SCALES["kitti"]}
 DEFAULT_SHARD_SIZE = 256
 RENDERED_LAYOUT = """\
 <root>/index.json

@@ -32,6 +32,8 @@ from lipjax.data import parallax
 from lipjax.data.sample import Sample
 from lipjax.zbuffer import nearest_per_cell
 
+DEFAULT_SAMPLER = "uniform:200"  # the sparse input where the data have none of their own (the paper's Table I)
+
 # A noisy sample must stay > 0: 0 means "no sample" and would silently drop the point.
 MIN_SPARSE_DEPTH_M = 1e-3
 

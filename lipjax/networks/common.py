@@ -1,6 +1,7 @@
 """Pieces shared by the end-to-end networks: the network input, GroupNorm, sub-pixel upsampling, the base class."""
 from __future__ import annotations
 
+import abc
 import math
 
 import flax.linen as nn
@@ -29,16 +30,18 @@ def network_input(rgb: jax.Array, sparse: jax.Array, max_depth_m: float, multipl
     return jnp.concatenate([d[..., None], c], axis=-1)
 
 
-def depth_to_space2(h: jax.Array, features: int) -> jax.Array:
-    """(B, H, W, 4 * features) -> (B, 2H, 2W, features)."""
-    b, hh, ww, _ = h.shape
-    h = h.reshape(b, hh, ww, 2, 2, features).transpose(0, 1, 3, 2, 4, 5)
-    return h.reshape(b, 2 * hh, 2 * ww, features)
-
-
 class NetworkModel(LearnedModel):
     """init / apply / parameter_count shared by the end-to-end networks (each defines `module()` and `multiple`;
     CSPN overrides `apply` with its propagation)."""
+
+    @property
+    @abc.abstractmethod
+    def multiple(self) -> int:
+        """Inputs are padded to a multiple of this in H and W (the network's total downsampling)."""
+
+    @abc.abstractmethod
+    def module(self) -> nn.Module:
+        """The Flax module: `network_input` (B, H', W', 4) -> depth / max_depth_m (B, H', W')."""
 
     def init(self, key: jax.Array):
         """Random parameters. Shapes do not depend on the image size (fully convolutional): init on the smallest

@@ -7,7 +7,8 @@ import flax.linen as nn
 import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, depth_to_space2, group_norm
+from lipjax.networks.common import NetworkModel, check_max_depth, group_norm
+from lipjax.priors.guided import depth_to_space
 
 
 class _DoubleConv(nn.Module):
@@ -46,7 +47,7 @@ class UNetBody(nn.Module):
         h = _DoubleConv(self.base_width * 2**self.levels)(h)
         for level in reversed(range(self.levels)):
             c = self.base_width * 2**level
-            h = depth_to_space2(nn.Conv(4 * c, (1, 1))(h), c)
+            h = depth_to_space(nn.Conv(4 * c, (1, 1))(h))
             h = _DoubleConv(c)(jnp.concatenate([h, skips[level]], axis=-1))
         return h
 

@@ -3,7 +3,7 @@
 A prior is the z-update of ADMM (paper eqs. 7-9):  z_{k+1} = prox(x_{k+1} + u_k, R).
 It knows nothing about the sampling operator A; the solver knows nothing about what the prior is.
 
-A prior is a hashable frozen dataclass (a static jit argument; lipjax.model.LIPConfig.prior) with:
+A prior is a hashable frozen dataclass (a static jit argument; lipjax.model.LIPConfig.prior) that implements `Prior`:
 
     max_depth_m: float       the depth range of the scenes it is made for, metres (lipjax.interfaces)
     init(key, image_shape, guidance_channels=3) -> params
@@ -24,6 +24,20 @@ from typing import Any, NamedTuple
 import jax
 
 Params = Any  # a pytree of arrays
+
+
+class Prior(abc.ABC):
+    """A prior with one operator per iteration, guided by the image as it is (the module docstring's interface)."""
+
+    max_depth_m: float  # the depth range of the scenes it is made for, metres
+
+    @abc.abstractmethod
+    def init(self, key: jax.Array, image_shape: tuple[int, int], guidance_channels: int = 3) -> Params:
+        """Parameters of ONE iteration's operator, for (H, W) images and a `guidance_channels`-channel guidance."""
+
+    @abc.abstractmethod
+    def apply(self, params: Params, v: jax.Array, rgb: jax.Array) -> jax.Array:
+        """z = prox(v): v (B, H, W) metres, rgb (B, H, W, C) guidance in [0, 1] -> z (B, H, W) metres."""
 
 
 class EncodedGuidance(NamedTuple):

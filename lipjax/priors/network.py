@@ -39,6 +39,7 @@ import jax
 import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_prior_type
+from lipjax.priors.base import Prior
 
 DOWNSAMPLING = 8  # three stride-2 bottleneck blocks
 LOG_DOMAIN_FLOOR = 1e-3  # depth_domain="log": v is floored at this fraction of max_depth before the log
@@ -124,7 +125,7 @@ class ProxNet(nn.Module):
 
 @register_prior_type("network")
 @dataclasses.dataclass(frozen=True)
-class NetworkPrior:
+class NetworkPrior(Prior):
     """The learned prox as a prior (lipjax.priors.base): hashable config + init/apply on a parameter pytree."""
 
     stem_width: int = 16

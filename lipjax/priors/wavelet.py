@@ -37,6 +37,7 @@ import jax
 import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_prior_type
+from lipjax.priors.base import Prior
 
 _SQRT2 = math.sqrt(2.0)
 _SQRT3 = math.sqrt(3.0)
@@ -166,7 +167,7 @@ def cycle_offsets(shifts: int, levels: int) -> list[int]:
 
 @register_prior_type("wavelet")
 @dataclasses.dataclass(frozen=True)
-class WaveletPrior:
+class WaveletPrior(Prior):
     """Wavelet soft-thresholding prox (the prior interface of lipjax.priors.base).
 
     Attributes:

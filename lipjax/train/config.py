@@ -12,8 +12,9 @@ from __future__ import annotations
 import dataclasses
 
 from lipjax.data.augment import Augment
+from lipjax.data.sampling import DEFAULT_SAMPLER
+from lipjax.interfaces import LearnedModel
 from lipjax.train.discriminator import Discriminator
-from lipjax.model import LIPConfig
 
 
 @dataclasses.dataclass(frozen=True)
@@ -42,8 +43,8 @@ class DataConfig:
     height: int = 256
     width: int = 320
     crop: tuple[int, int] | None = (128, 160)
-    train_sampler: str = "uniform:200"
-    val_sampler: str = "uniform:200"
+    train_sampler: str = DEFAULT_SAMPLER
+    val_sampler: str = DEFAULT_SAMPLER
     val_images: int | None = 32
     num_workers: int = 1
     source: str = "synthetic"
@@ -64,7 +65,7 @@ class TrainConfig:
     """Everything that defines a training run. Step counts are global optimisation steps."""
 
     name: str
-    model: LIPConfig
+    model: LearnedModel  # LIP (lipjax.model.LIPConfig) or an end-to-end network
     data: DataConfig = DataConfig()
     discriminator: Discriminator = Discriminator()
     batch_size: int = 8

@@ -128,7 +128,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
 
 
 def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str | None = None,
-                     steps: int | None = None, batch_size: int = 8, workdir: str | os.PathLike | None = None,
+                     steps: int | None = None, batch_size: int | None = None, workdir: str | os.PathLike | None = None,
                      progress: bool = True, log: Callable[[str], None] | None = None, **data: Any) -> dict:
     """`lipjax train`: fine-tunes a model on a folder of RGB-D frames (lipjax.train.folder) and exports it to
     `out` (a model path stem, also the run's name).
@@ -136,7 +136,7 @@ def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: s
     Args:
       init: the model to start from (name or path); None: the default model of the frames' scene
         (lipjax.train.folder.default_init), named with its reason to `log` (a callable taking a line) if given.
-      steps: training steps (default folder_config's 2000). batch_size: frames per step.
+      steps: training steps, batch_size: frames per step (None: folder_config's FOLDER_STEPS, FOLDER_BATCH_SIZE).
       workdir: checkpoints and logs (default runs/train-<out name>).
       data: DataConfig fields over lipjax.train.folder.FOLDER_DATA (depth_scale, crop, train_sampler, num_workers);
         None keeps FOLDER_DATA's.
@@ -150,5 +150,5 @@ def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: s
             log(f"init: {init}, the default for {scene} input ({why}); choose another with --init")
     name = pathlib.Path(out).name
     config = folder_config(model_io.load(init)[0], init, name=name, **data)
-    config = dataclasses.replace(config, batch_size=batch_size, **({"g_steps": steps} if steps else {}))
+    config = dataclasses.replace(config, **{k: v for k, v in (("g_steps", steps), ("batch_size", batch_size)) if v})
     return run(config, workdir or f"runs/train-{name}", export=out, progress=progress, validate_start=True)
