@@ -1,11 +1,13 @@
 """The paper's Table II: KITTI depth completion (64-beam LiDAR), RMSE / MAE in mm, iRMSE / iMAE in 1/km, params in M.
 
-    python -m experiments.kitti_dc                                    # embedded outdoor split, HDL-64 pattern
+    python -m experiments.kitti_dc                                    # KITTI if found, else the synthetic split
     python -m experiments.kitti_dc --data-dir /data/kitti_depth       # KITTI DC val_selection_cropped
     python -m experiments.kitti_dc --variant smoke --out /tmp/k
 
-Without --data-dir it runs on the embedded synthetic outdoor test split at 128x416 (KITTI aspect) with a
-simulated HDL-64E pattern (lipjax.data.sampling.LidarSampler.hdl64). With --data-dir it reads
+Without --data-dir, KITTI is looked for in $LIPJAX_KITTI_DIR, then data/kitti_depth, ~/data/kitti_depth and
+/data/kitti_depth (lipjax.data.locate); when it is not there, the run uses the embedded synthetic outdoor test split
+at 128x416 (KITTI aspect) with a simulated HDL-64E pattern (lipjax.data.sampling.LidarSampler.hdl64) and says so.
+On KITTI it reads
 depth_selection/val_selection_cropped (the kitti_selection source of lipjax.data.sources, as training reads data)
 and uses the real velodyne_raw scans as input (protocol kitti_selection).
 Writes results.json, table.md and figure.png into --out (default out/kitti_dc). About 3 minutes by default.
@@ -26,6 +28,7 @@ from experiments.common import (
     write_results,
 )
 from lipjax.console import ArgumentParser, positive_int, run_main
+from lipjax.data.locate import find_data_root, not_found_note
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.evaluate import open_eval_source
@@ -61,16 +64,18 @@ def main(argv=None) -> dict:
     if args.limit is not None:
         config = dataclasses.replace(config, limit=args.limit)
     methods = args.methods.split(",") if args.methods else list(config.methods or available_methods("outdoor"))
-    if args.data_dir:
-        source, protocol = open_eval_source("kitti_selection", args.data_dir, sampler="input")
+    data_dir = args.data_dir or find_data_root("kitti")
+    if data_dir:
+        source, protocol = open_eval_source("kitti_selection", data_dir, sampler="input")
         dataset, sampler, sampler_name = source.dataset, source.sampler, "real velodyne_raw"
-        data_name = f"KITTI DC val_selection_cropped ({args.data_dir})"
+        data_name = f"KITTI DC val_selection_cropped ({data_dir})"
+        print(f"[lipjax] KITTI depth completion from {data_dir}", flush=True)
     else:
         protocol = get_protocol("synthetic_outdoor")
         dataset = synthetic_outdoor_test()
         sampler, sampler_name = sampler_from_spec(config.sampler), config.sampler
         data_name = "embedded synthetic outdoor test split, 128x416 (lipjax.data.synthetic)"
-        print("[lipjax] no --data-dir: KITTI is not on this machine, so this runs on the embedded synthetic outdoor "
+        print(f"[lipjax] KITTI not found ({not_found_note('kitti')}), so this runs on the embedded synthetic outdoor "
               f"test split with a simulated {config.sampler} pattern.", flush=True)
     completers = load_methods(methods)
     results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,

@@ -1,6 +1,6 @@
 """The paper's Table I: depth completion from 200 points on NYU Depth v2 (or the embedded synthetic indoor data).
 
-    python -m experiments.nyu_200pts                                   # embedded synthetic indoor test split
+    python -m experiments.nyu_200pts                                   # NYU if found, else the synthetic split
     python -m experiments.nyu_200pts --data-dir /data/nyudepthv2       # NYU val (h5), the paper's protocol
     python -m experiments.nyu_200pts --data-dir ... --protocol ma      # Ma et al.'s 228x304 protocol
     python -m experiments.nyu_200pts --variant smoke --out /tmp/x      # a 2-image check
@@ -8,7 +8,10 @@
 Writes to --out (default out/nyu_200pts): results.json (every method's aggregated metrics, units in the keys,
 with data set, protocol, sampler, seed and image count), table.md, and figure.png (the paper's Fig. 3: 3 frames,
 the 4 key methods, each with its error map).
-Default variant: 100 synthetic test frames at 256x320, every available method; about 5 minutes on 2 CPU cores.
+Without --data-dir, NYU is looked for in $LIPJAX_NYU_DIR, then data/nyudepthv2, ~/data/nyudepthv2 and
+/data/nyudepthv2 (lipjax.data.locate); when it is not there, the run uses the embedded synthetic indoor test split
+and says so. Default variant: 100 frames (synthetic: 256x320), every available method; about 5 minutes on 2 CPU
+cores on the synthetic split.
 """
 from __future__ import annotations
 
@@ -19,6 +22,7 @@ import sys
 
 from experiments.common import evaluate_methods, load_methods, parameter_counts, qualitative_figure, write_results
 from lipjax.console import ArgumentParser, positive_int, run_main
+from lipjax.data.locate import find_data_root, not_found_note
 from lipjax.data.protocols import get_protocol
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
@@ -72,17 +76,18 @@ def main(argv=None) -> dict:
         methods = _retrain(out, args.train_steps) + [m for m in methods if not m.startswith(("lip-cnn", "lip-ad"))]
 
     sampler_spec = f"uniform:{config.num_points}"
-    if args.data_dir:  # the nyu_h5 source, read as training reads it
-        source, protocol = open_eval_source("nyu_h5", args.data_dir, sampler=sampler_spec,
-                                            protocol=f"nyu_{args.protocol}")
+    data_dir = args.data_dir or find_data_root("nyu")
+    if data_dir:  # the nyu_h5 source, read as training reads it
+        source, protocol = open_eval_source("nyu_h5", data_dir, sampler=sampler_spec, protocol=f"nyu_{args.protocol}")
         dataset, sampler = source.dataset, source.sampler
-        data_name = f"NYU Depth v2 val ({args.data_dir})"
+        data_name = f"NYU Depth v2 val ({data_dir})"
+        print(f"[lipjax] NYU Depth v2 from {data_dir}", flush=True)
     else:
         protocol = get_protocol("synthetic_indoor")
         dataset, sampler = SyntheticDataset("indoor", "test"), sampler_from_spec(sampler_spec)
         data_name = "embedded synthetic indoor test split (lipjax.data.synthetic)"
-        print("[lipjax] no --data-dir: NYU Depth v2 is not on this machine, so this runs on the embedded synthetic "
-              "indoor test split (256x320). Pass --data-dir to use NYU.", flush=True)
+        print(f"[lipjax] NYU Depth v2 not found ({not_found_note('nyu')}), so this runs on the embedded synthetic "
+              "indoor test split (256x320).", flush=True)
     completers = load_methods(methods)
     results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)

@@ -1,6 +1,7 @@
 """Smoke tests of the experiment entry points: each runs its `smoke` variant end to end and writes its files."""
 import json
 
+import h5py
 import jax
 import numpy as np
 import pytest
@@ -8,13 +9,22 @@ import pytest
 from experiments import convergence, kitti_dc, nyu_200pts, sample_rate, table3
 from lipjax import model_io
 from lipjax.console import run_main
+from lipjax.data import locate
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 
 
-def test_nyu_200pts_smoke_writes_results_table_and_figure(tmp_path, capsys):
+@pytest.fixture
+def no_real_data(monkeypatch):
+    """Neither NYU nor KITTI on this machine, whatever /data or ~/data hold: the experiments use the synthetic data."""
+    for env in locate.ROOT_ENV.values():
+        monkeypatch.delenv(env, raising=False)
+    monkeypatch.setattr(locate, "USUAL_PLACES", {name: () for name in locate.USUAL_PLACES})
+
+
+def test_nyu_200pts_smoke_writes_results_table_and_figure(tmp_path, capsys, no_real_data):
     metrics = nyu_200pts.main(["--variant", "smoke", "--out", str(tmp_path)])
-    assert "embedded synthetic indoor test split" in capsys.readouterr().out
+    assert "NYU Depth v2 not found (--data-dir, $LIPJAX_NYU_DIR" in capsys.readouterr().out
     doc = json.loads((tmp_path / "results.json").read_text())
     assert doc["meta"]["sampler"] == "uniform:200" and doc["meta"]["num_images"] == 2
     assert set(doc["methods"]) == {"nearest", "linear"}
@@ -43,8 +53,26 @@ def test_figures_show_the_three_best_methods_and_the_best_without_learned_weight
     assert key_methods({m: result(r) for m, r in rmse.items()}, completers) == ["a", "b", "linear", "d"]
 
 
-def test_kitti_dc_smoke(tmp_path):
+def test_nyu_200pts_runs_on_nyu_when_it_is_on_disk(tmp_path, capsys, no_real_data, monkeypatch):
+    """With NYU where the user keeps it ($LIPJAX_NYU_DIR here) and no flag, Table I is measured on NYU."""
+    rng = np.random.default_rng(0)
+    for n in (1, 2):
+        path = tmp_path / "nyudepthv2" / "val" / "office_0001" / f"{n}.h5"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with h5py.File(path, "w") as f:  # Ma et al.'s layout at NYU's 480x640
+            f["rgb"] = rng.integers(0, 256, (3, 480, 640), dtype=np.uint8)
+            f["depth"] = rng.uniform(1.0, 9.0, (480, 640)).astype(np.float32)
+    monkeypatch.setenv("LIPJAX_NYU_DIR", str(tmp_path / "nyudepthv2"))
+    nyu_200pts.main(["--variant", "smoke", "--out", str(tmp_path / "out")])
+    assert f"NYU Depth v2 from {tmp_path / 'nyudepthv2'}" in capsys.readouterr().out
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert doc["meta"]["dataset"].startswith("NYU Depth v2 val") and doc["meta"]["num_images"] == 2
+    assert doc["meta"]["protocol"] == "nyu_paper"
+
+
+def test_kitti_dc_smoke(tmp_path, capsys, no_real_data):
     kitti_dc.main(["--variant", "smoke", "--out", str(tmp_path)])
+    assert "KITTI not found (--data-dir, $LIPJAX_KITTI_DIR" in capsys.readouterr().out
     doc = json.loads((tmp_path / "results.json").read_text())
     assert doc["meta"]["sampler"] == "lidar:hdl64"
     row = doc["methods"]["ip_basic"]
