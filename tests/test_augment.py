@@ -79,6 +79,10 @@ def test_photometric_identity_and_range():
     np.testing.assert_array_equal(photometric(rgb, Augment(), rng), rgb)
     out = photometric(rgb, Augment(brightness=0.5, contrast=0.5, saturation=0.5, gamma=1.0), rng)
     assert out.dtype == np.uint8 and not np.array_equal(out, rgb)
+    # Brightness alone is one gain b ~ U(0.5, 1.5) on every channel, clipped to the uint8 range.
+    b = np.random.default_rng(7).uniform(0.5, 1.5)
+    expected = np.round(np.clip(rgb.astype(np.float32) / 255 * np.float32(b), 0, 1) * 255).astype(np.uint8)
+    np.testing.assert_array_equal(photometric(rgb, Augment(brightness=0.5), np.random.default_rng(7)), expected)
 
 
 def test_sensor_noise_is_relative_and_outliers_only_push_samples_back():

@@ -17,25 +17,20 @@ import lipjax.methods
 from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
+from lipjax.inference import complete_frame
 from lipjax.uncertainty import mask_unsupported
+
+from helpers import perturbed
 
 H, W = 24, 32
 SCALE = 256.0
 CONFIG = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
-CACHE = pathlib.Path(__file__).resolve().parents[1] / ".jax_cache"  # the cache conftest set up
-
-
-@pytest.fixture(autouse=True)
-def _same_compilation_cache(monkeypatch):
-    # main() calls enable_compilation_cache(); point it at the cache the test session already uses.
-    monkeypatch.setenv("LIPJAX_CACHE_DIR", str(CACHE))
-
 
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
     """(path stem of a saved tiny model, the same model as a Completer)."""
     stem = tmp_path_factory.mktemp("model") / "tiny"
-    c = lipjax.Completer.random(CONFIG, seed=1)
+    c = perturbed(lipjax.Completer.random(CONFIG, seed=1))
     model_io.save(stem, CONFIG, c.params)
     return str(stem), lipjax.load_model(stem)
 
@@ -120,12 +115,15 @@ def test_folder_batch_pairs_frames_by_trailing_number(model, tmp_path):
 
 
 def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, tmp_path):
-    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16") == 0
+    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16", "--fill-all") == 0
     out = np.load(tmp_path / "out.npy")
     sparse = frame["sparse_array"]
     assert out.shape == (H, W)
     np.testing.assert_array_equal(out[sparse > 0], sparse[sparse > 0])
-    assert (out > 0).all()
+    # The library's frame path at that size, value for value (--fill-all: no support mask).
+    expected = complete_frame(model[1], frame["rgb_array"], sparse, max_side=16)
+    np.testing.assert_allclose(out, expected, rtol=1e-6, atol=1e-6)
+    assert not np.allclose(out, complete_frame(model[1], frame["rgb_array"], sparse), atol=1e-3)  # it did downsize
 
 
 @pytest.mark.parametrize("case, message", [
@@ -255,7 +253,7 @@ def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsy
     with pytest.warns(UserWarning, match="beyond the 10 m range"):
         dense = mask_unsupported(model[1](rgb, sparse * 8), sparse * 8)
     top = np.percentile(dense[dense > 0], 99)
-    assert 20 < top < 40 and model[1].config.max_depth_m == 10
+    assert top > model[1].config.max_depth_m == 10  # beyond the model's range: the colours fit the output
     np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, top))
     err = capsys.readouterr().err.splitlines()
     assert err[0].startswith("lipjax: warning: sparse depth beyond the 10 m range of the indoor model")
@@ -374,7 +372,7 @@ def test_evaluate_own_folder_pairs_sparse_maps_by_number_as_it_pairs_depth(tmp_p
 def test_subprocess_error_has_no_traceback(tmp_path):
     (tmp_path / "broken.jpg").write_bytes(b"\xff\xd8 truncated")
     np.save(tmp_path / "s.npy", np.ones((4, 4), np.float32))
-    env = {**os.environ, "LIPJAX_CACHE_DIR": str(CACHE)}
+    env = dict(os.environ)  # with conftest's LIPJAX_CACHE_DIR
     env.pop("LIPJAX_DEBUG", None)
     result = subprocess.run(
         [sys.executable, "-m", "lipjax.cli", "complete", "--rgb", str(tmp_path / "broken.jpg"),
@@ -428,6 +426,8 @@ def test_export_command_writes_a_deserializable_file(model, tmp_path):
     exported = jax.export.deserialize(bytearray(out.read_bytes()))
     assert [a.shape for a in exported.in_avals] == [(2, 8, 16, 3), (2, 8, 16)]
     assert exported.out_avals[0].shape == (2, 8, 16)
+    rgb, sparse = (np.stack(a) for a in zip(_frame(seed=5, h=8, w=16), _frame(seed=6, h=8, w=16)))
+    np.testing.assert_allclose(np.asarray(exported.call(rgb, sparse)), model[1](rgb, sparse), rtol=1e-5, atol=1e-5)
 
 
 def test_export_command_writes_an_onnx_graph_with_the_fill_inside(model, tmp_path, capsys):

@@ -5,13 +5,11 @@ stderr) or a one-line error (exit 1 "lipjax: error: ...", exit 2 for a usage err
 `linear` or `nearest`, so no case waits for a compilation."""
 import contextlib
 import io
-import os
 import pathlib
 import tempfile
 
 import cv2
 import numpy as np
-import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -121,7 +119,7 @@ def _check_output(path: pathlib.Path, h: int, w: int) -> None:
 
 @settings(max_examples=150, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 @given(case=complete_cases())
-def test_complete_ends_in_a_documented_output_or_a_one_line_error(case, compilation_cache):
+def test_complete_ends_in_a_documented_output_or_a_one_line_error(case):
     rng = np.random.default_rng(case["seed"])
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
@@ -149,14 +147,3 @@ def test_complete_ends_in_a_documented_output_or_a_one_line_error(case, compilat
             assert rc == 2 and len(lines) == 1 and lines[0].startswith("lipjax complete: error: "), (case, rc, lines)
 
 
-@pytest.fixture(scope="module")
-def compilation_cache():
-    """main() enables the persistent compilation cache; point it at the one the test session uses (conftest)."""
-    cache = pathlib.Path(__file__).resolve().parents[1] / ".jax_cache"
-    before = os.environ.get("LIPJAX_CACHE_DIR")
-    os.environ["LIPJAX_CACHE_DIR"] = str(cache)
-    yield
-    if before is None:
-        os.environ.pop("LIPJAX_CACHE_DIR")
-    else:
-        os.environ["LIPJAX_CACHE_DIR"] = before

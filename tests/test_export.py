@@ -11,6 +11,8 @@ from lipjax.export import export_completer, load_exported, save_exported
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 
+from helpers import perturbed
+
 # jax.export serialisation needs flatbuffers, an optional jax dependency (to be listed in pyproject).
 pytest.importorskip("flatbuffers")
 
@@ -19,14 +21,8 @@ B, H, W = 2, 24, 32
 
 @pytest.fixture(scope="module")
 def completer():
-    # A random (non-zero) head, so the network really changes the depth and the comparison is not trivial.
-    c = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), num_iterations=1), seed=3)
-    import jax
-
-    leaves, treedef = jax.tree_util.tree_flatten(c.params)
-    rng = np.random.default_rng(0)
-    leaves = [np.asarray(x) + 0.05 * rng.standard_normal(np.shape(x)).astype(np.float32) for x in leaves]
-    return lipjax.Completer(c.config, jax.tree_util.tree_unflatten(treedef, leaves), "perturbed")
+    # A non-zero head, so the network really changes the depth and the comparison is not trivial.
+    return perturbed(lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), num_iterations=1), seed=3))
 
 
 @pytest.fixture(scope="module")

@@ -20,23 +20,19 @@ from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 from lipjax.utils import written_whole
 
+from helpers import perturbed
+
 H, W = 24, 32
 SCALE = 256.0
 CONFIG = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
-CACHE = pathlib.Path(__file__).resolve().parents[1] / ".jax_cache"
 INTRINSICS = ["--intrinsics", "30", "30", "15.5", "11.5"]
-
-
-@pytest.fixture(autouse=True)
-def _same_compilation_cache(monkeypatch):
-    monkeypatch.setenv("LIPJAX_CACHE_DIR", str(CACHE))  # main() enables the cache: the one the session uses
 
 
 @pytest.fixture(scope="module")
 def model(tmp_path_factory):
-    """The path stem of a saved tiny model with random weights (the network changes the depth)."""
+    """The path stem of a saved tiny model with perturbed weights (the network changes the depth)."""
     stem = tmp_path_factory.mktemp("model") / "tiny"
-    model_io.save(stem, CONFIG, lipjax.Completer.random(CONFIG, seed=1).params)
+    model_io.save(stem, CONFIG, perturbed(lipjax.Completer.random(CONFIG, seed=1)).params)
     return str(stem)
 
 

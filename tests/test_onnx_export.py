@@ -16,6 +16,8 @@ from lipjax.onnx_export import (export_onnx, export_working_size, inference_grap
 from lipjax.priors.guided import PRESETS
 from lipjax.resolution import MAX_WORKING_PIXELS, working_size
 
+from helpers import perturbed
+
 pytest.importorskip("onnx")
 ort = pytest.importorskip("onnxruntime")
 
@@ -85,12 +87,9 @@ def test_the_working_size_is_fixed_from_the_sample_count_for_an_interval_of_coun
 def auto_model():
     """A tiny shared-encoder LIP model (as the shipped ones) with random, non-zero weights and the "auto" fill."""
     config = LIPConfig(prior=PRESETS["tiny"], num_iterations=2, initial_estimate="auto", output="z")
-    c = lipjax.Completer.random(config, seed=1)
-    leaves, treedef = jax.tree_util.tree_flatten(c.params)
-    rng = np.random.default_rng(0)
-    leaves = [np.asarray(a) + 0.05 * rng.standard_normal(np.shape(a)).astype(np.float32) for a in leaves]
-    return lipjax.Completer(config, jax.tree_util.tree_unflatten(treedef, leaves), "tiny-auto",
-                            {"train_sampler": "uniform:10|lidar:hdl64"})  # no input warning for either pattern
+    c = lipjax.Completer(config, lipjax.Completer.random(config, seed=1).params, "tiny-auto",
+                         {"train_sampler": "uniform:10|lidar:hdl64"})  # no input warning for either pattern
+    return perturbed(c)
 
 
 def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path):

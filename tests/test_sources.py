@@ -33,6 +33,8 @@ from lipjax.train import loop
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import init_state
 
+from helpers import alive, children
+
 H, W = 30, 40  # fixture frames; training crops are CROP
 CROP = (24, 32)
 DRIVE = "2011_09_26_drive_0002_sync"
@@ -270,6 +272,7 @@ def test_workers_resume_bit_identically(tmp_path):
     straight = loop.train(config, tmp_path / "straight", progress=False)
     loop.train(config, tmp_path / "killed", stop_at=1, progress=False)
     resumed = loop.train(config, tmp_path / "killed", progress=False)
+    assert jax.tree_util.tree_structure(straight.g_params) == jax.tree_util.tree_structure(resumed.g_params)
     for a, b in zip(jax.tree_util.tree_leaves(straight.g_params), jax.tree_util.tree_leaves(resumed.g_params)):
         assert np.array_equal(np.asarray(a), np.asarray(b))
 
@@ -440,7 +443,6 @@ def test_a_stopped_render_takes_its_workers_with_it_and_the_same_command_finishe
     (exit 143 / 130); the finished shards stay as they were, and the same render finishes the set, bit for bit
     what an uninterrupted render writes."""
     from lipjax.data.rendered import RenderSpec, _render_shard
-    from test_train import _alive, _children
 
     out, count = tmp_path / "r", 120
     args = ["data", "render", "--kind", "indoor", "--count", str(count), "--height", "256", "--width", "320",
@@ -452,7 +454,7 @@ def test_a_stopped_render_takes_its_workers_with_it_and_the_same_command_finishe
         deadline = time.time() + 120
         while not list(out.glob("shard-*.depth.npy")) and time.time() < deadline:
             time.sleep(0.05)
-        workers = _children(proc.pid)
+        workers = children(proc.pid)
         assert len(workers) >= 2  # the two workers (and multiprocessing's resource tracker)
         if signum == signal.SIGINT:
             os.killpg(proc.pid, signum)
@@ -462,9 +464,9 @@ def test_a_stopped_render_takes_its_workers_with_it_and_the_same_command_finishe
     finally:
         proc.kill()
     deadline = time.time() + 20
-    while [w for w in workers if _alive(w)] and time.time() < deadline:
+    while [w for w in workers if alive(w)] and time.time() < deadline:
         time.sleep(0.1)
-    assert not [w for w in workers if _alive(w)], "render processes outlived the command"
+    assert not [w for w in workers if alive(w)], "render processes outlived the command"
     if signum != signal.SIGKILL:
         assert (tmp_path / "err.txt").read_text() == (f"lipjax: render stopped; its finished shards stay in {out}, "
                                                       "and the same command finishes it\n")

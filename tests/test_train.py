@@ -22,6 +22,8 @@ from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import init_state
 
+from helpers import alive, children
+
 # One tiny config shared by the tests in this file, so that the jitted steps compile once (make_steps is cached).
 CONFIG = TrainConfig(
     name="test",
@@ -33,8 +35,9 @@ CONFIG = TrainConfig(
 
 
 def _leaves_equal(a, b):
-    return all(np.array_equal(np.asarray(x), np.asarray(y))
-               for x, y in zip(jax.tree_util.tree_leaves(a), jax.tree_util.tree_leaves(b)))
+    """Same tree structure and every leaf bit-identical."""
+    (xs, x_tree), (ys, y_tree) = jax.tree_util.tree_flatten(a), jax.tree_util.tree_flatten(b)
+    return x_tree == y_tree and all(np.array_equal(np.asarray(x), np.asarray(y)) for x, y in zip(xs, ys, strict=True))
 
 
 @pytest.fixture(scope="module")
@@ -125,12 +128,27 @@ def test_non_finite_loss_stops_and_keeps_last_good_checkpoint(tmp_path, monkeypa
     assert CheckpointManager(tmp_path / "checkpoints").latest_step() == 2
 
 
-def test_host_initial_estimate_reaches_the_train_step(tmp_path):
+def test_host_initial_estimate_reaches_the_train_step(tmp_path, monkeypatch):
     """A model whose z_0 is computed on the host trains: the loop adds z0 to each batch after cropping."""
+    from lipjax.classical.nearest import nearest_fill
+
+    calls = []
+    host_inputs = LIPConfig.host_inputs
+
+    def recording(self, sparse):
+        extra = host_inputs(self, sparse)
+        calls.append((np.asarray(sparse), extra))
+        return extra
+
+    monkeypatch.setattr(LIPConfig, "host_inputs", recording)
     model = dataclasses.replace(CONFIG.model, initial_estimate="nearest")
     config = dataclasses.replace(CONFIG, name="host-init", model=model, g_steps=2, d_steps=0, adv_steps=0,
                                  eval_every=2)
     state = loop.train(config, tmp_path, progress=False)
+    shapes = [sparse.shape for sparse, _ in calls]
+    assert shapes.count((2, 24, 32)) >= 2 and (2, 32, 40) in shapes  # each training crop, and the full val frames
+    for sparse, extra in calls:
+        np.testing.assert_array_equal(extra["z0"], np.stack([nearest_fill(s) for s in sparse]))
     assert int(state.step) == 2
     rows = [json.loads(line) for line in (tmp_path / "metrics.jsonl").read_text().splitlines()]
     assert all(np.isfinite(r["loss"]) for r in rows if "phase" in r)
@@ -233,26 +251,6 @@ def test_train_command_errors_are_one_line(args, message, capsys):
     assert exit_.value.code == 2 and message in err and len(err.splitlines()) == 1
 
 
-def _alive(pid: int) -> bool:
-    try:
-        return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
-    except OSError:
-        return False
-
-
-def _children(pid: int) -> set[int]:
-    """Pids of the live processes whose parent is `pid` (Linux /proc)."""
-    kids = set()
-    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[1]) == pid and fields[0] != "Z":
-            kids.add(int(stat.parent.name))
-    return kids
-
-
 def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[int], list[int], list[int], str]:
     """Starts `experiments.train --config smoke` (2 loader workers, no checkpoint due) in a process group of its
     own, as a terminal's foreground job, and sends `signum` once it has logged 2 steps: to the process (SIGTERM) or
@@ -270,7 +268,7 @@ def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[i
         deadline = time.time() + 240
         while not (metrics.exists() and metrics.read_text().count("\n") >= 2) and time.time() < deadline:
             time.sleep(0.2)
-        workers = _children(proc.pid)
+        workers = children(proc.pid)
         assert workers, "the run should have a loader worker process"
         os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
         status = proc.wait(timeout=60)
@@ -283,9 +281,9 @@ def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[i
 
 def _workers_end(workers: set[int]) -> bool:
     deadline = time.time() + 20
-    while [w for w in workers if _alive(w)] and time.time() < deadline:
+    while [w for w in workers if alive(w)] and time.time() < deadline:
         time.sleep(0.2)
-    return not [w for w in workers if _alive(w)]
+    return not [w for w in workers if alive(w)]
 
 
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
@@ -363,7 +361,13 @@ def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_
 # A run long enough to be killed mid-way (the straight CONFIG ends within a second of compiling), with one loader
 # worker process, checkpoints every 3 steps.
 KILLED = dataclasses.replace(CONFIG, name="killed", g_steps=24, d_steps=0, adv_steps=0, checkpoint_every=3,
-                             data=dataclasses.replace(CONFIG.data, num_workers=1))
+                             eval_every=0, data=dataclasses.replace(CONFIG.data, num_workers=1))  # one row a step
+
+
+def _steps_logged(metrics: pathlib.Path) -> int:
+    """The last training step in a run's metrics.jsonl (0 before the first)."""
+    rows = [json.loads(line) for line in metrics.read_text().splitlines() if line.strip()] if metrics.exists() else []
+    return max((row["step"] for row in rows), default=0)
 
 
 @pytest.fixture(scope="module")
@@ -375,31 +379,31 @@ def killed_reference(tmp_path_factory):
 @pytest.mark.parametrize("signum", [signal.SIGKILL, signal.SIGTERM, signal.SIGINT], ids=["kill", "term", "int"])
 def test_a_run_killed_at_a_random_step_resumes_bit_identical_and_leaves_no_process(killed_reference, tmp_path,
                                                                                    signum):
-    """A real training process killed at a random step (seeded: the same step every run of the suite) by SIGKILL
-    (nothing saved: resume from the last periodic checkpoint), SIGTERM or Ctrl-C (the step in progress saved) resumes
-    to parameters and optimiser state bit-identical to an uninterrupted run, and none of its processes outlives it."""
+    """A real training process killed once it has logged a seeded random step (the signal may land a step or two
+    later) by SIGKILL (nothing saved: resume from the last periodic checkpoint), SIGTERM or Ctrl-C (the step in
+    progress saved) resumes to parameters and optimiser state bit-identical to an uninterrupted run, and none of its
+    processes outlives it."""
     kill_after = int(np.random.default_rng(int(signum)).integers(2, KILLED.total_steps - 4))
     workdir = tmp_path / "run"
-    script = ("import sys; from tests.test_train import KILLED; from lipjax.train import loop; "
+    script = ("import sys; sys.path.insert(0, 'tests'); from test_train import KILLED; from lipjax.train import loop; "
               "loop.train(KILLED, sys.argv[1], progress=False)")
     proc = subprocess.Popen([sys.executable, "-c", script, str(workdir)], cwd=pathlib.Path(__file__).parents[1],
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
     metrics = workdir / "metrics.jsonl"
     try:
         deadline = time.time() + 240
-        while not (metrics.exists() and metrics.read_text().count("\n") >= kill_after) and time.time() < deadline:
+        while _steps_logged(metrics) < kill_after and time.time() < deadline:
             time.sleep(0.02)
-        family = _children(proc.pid) | {proc.pid}
+        family = children(proc.pid) | {proc.pid}
         os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
         proc.wait(timeout=60)
     finally:
         proc.kill()
-    logged = metrics.read_text().count("\n")
-    assert logged < KILLED.total_steps, "the run ended before the kill: nothing was tested"
+    assert _steps_logged(metrics) < KILLED.total_steps, "the run ended before the kill: nothing was tested"
     deadline = time.time() + 20
-    while [p for p in family if _alive(p)] and time.time() < deadline:
+    while [p for p in family if alive(p)] and time.time() < deadline:
         time.sleep(0.2)
-    assert not [p for p in family if _alive(p)], "a process of the killed run outlived it"
+    assert not [p for p in family if alive(p)], "a process of the killed run outlived it"
     resumed = loop.train(KILLED, workdir, progress=False)
     assert int(resumed.step) == KILLED.total_steps
     assert _leaves_equal(killed_reference.g_params, resumed.g_params)
