@@ -135,8 +135,12 @@ class LIPConfig(LearnedModel):
             raise ValueError(f"initial_estimate must be one of {INITIAL_ESTIMATES}, got {self.initial_estimate!r}")
 
 
+@functools.partial(jax.jit, static_argnums=0)
 def init(config: LIPConfig, key: jax.Array) -> Params:
-    """Random parameters: one prox set per iteration (independent keys), or one shared set."""
+    """Random parameters: one prox set per iteration (independent keys), or one shared set.
+
+    Compiled as one program (cached per config): run eagerly, each random draw compiled on its own (~40 s for the
+    default config here, against ~20 s, and nothing on a second run with the persistent cache)."""
     # Parameter shapes never depend on the image size (fully convolutional priors); a small one keeps init cheap.
     channels = 5 if config.guidance == "rgb+mask" else 3
     init_one = functools.partial(config.prior.init, image_shape=(64, 64), guidance_channels=channels)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import abc
+import functools
 import math
 
 import flax.linen as nn
@@ -14,6 +15,13 @@ from lipjax.interfaces import LearnedModel, parameter_count
 def group_norm(channels: int) -> nn.GroupNorm:
     """GroupNorm with up to 8 groups; the group count must divide the channels (12 channels -> 4 groups)."""
     return nn.GroupNorm(num_groups=math.gcd(8, channels))
+
+
+@functools.partial(jax.jit, static_argnums=0)
+def _init(network: "NetworkModel", key: jax.Array):
+    """One compiled program per network config (eagerly, every random draw compiles on its own)."""
+    n = network.multiple
+    return network.module().init(key, jnp.zeros((1, n, n, 4), jnp.float32))["params"]
 
 
 def network_input(rgb: jax.Array, sparse: jax.Array, max_depth_m: float, multiple: int) -> jax.Array:
@@ -46,9 +54,7 @@ class NetworkModel(LearnedModel):
     def init(self, key: jax.Array):
         """Random parameters. Shapes do not depend on the image size (fully convolutional): init on the smallest
         input the network accepts."""
-        n = self.multiple
-        x = jnp.zeros((1, n, n, 4), jnp.float32)
-        return self.module().init(key, x)["params"]
+        return _init(self, key)
 
     def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False):
         """Dense depth (B, H, W) metres from rgb (B, H, W, 3) and sparse (B, H, W) metres; `weights` is unused.

@@ -15,6 +15,7 @@ Depth features (`inputs`):
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import flax.linen as nn
 import jax
@@ -56,6 +57,13 @@ class _PatchDiscriminator(nn.Module):
         return nn.Conv(1, (3, 3))(h)[..., 0]
 
 
+@functools.partial(jax.jit, static_argnums=(0, 2))
+def _init(discriminator: "Discriminator", key: jax.Array, image_shape: tuple[int, int]):
+    """One compiled program per config (eagerly, every random draw compiles on its own)."""
+    z = jnp.zeros((1, *image_shape))
+    return discriminator.module().init(key, z, jnp.zeros((1, *image_shape, 3)), z)["params"]
+
+
 @dataclasses.dataclass(frozen=True)
 class Discriminator:
     """Config + functional init/apply. apply(params, depth (B,H,W) m, rgb (B,H,W,3) [0,1], valid (B,H,W)) -> logits."""
@@ -72,8 +80,7 @@ class Discriminator:
         return _PatchDiscriminator(tuple(self.widths), self.max_depth_m, self.inputs)
 
     def init(self, key: jax.Array, image_shape: tuple[int, int] = (64, 64)):
-        z = jnp.zeros((1, *image_shape))
-        return self.module().init(key, z, jnp.zeros((1, *image_shape, 3)), z)["params"]
+        return _init(self, key, tuple(image_shape))
 
     def apply(self, params, depth, rgb, valid):
         return self.module().apply({"params": params}, depth, rgb, valid)
