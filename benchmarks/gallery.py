@@ -20,29 +20,15 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 from lipjax.data import synthetic  # noqa: E402
+from lipjax.data.sampling import sampler_from_spec  # noqa: E402
+from lipjax.interfaces import SCENE_MAX_DEPTH_M  # noqa: E402
 
-try:
-    from lipjax.data.sampling import sampler_from_spec
-except ImportError:  # the samplers are optional for this picture
-    sampler_from_spec = None
-
-MAX_DEPTH_M = {"indoor": 10.0, "outdoor": synthetic.RENDER_FAR_CLIP_M}
+MAX_DEPTH_M = {"indoor": SCENE_MAX_DEPTH_M["indoor"], "outdoor": synthetic.RENDER_FAR_CLIP_M}
 
 
 def sparse_input(sample, kind: str) -> np.ndarray:
     """(H, W) sparse depth, 0 = no point."""
-    if sampler_from_spec is not None:
-        return sampler_from_spec("uniform:200" if kind == "indoor" else "lidar:hdl64")(sample)
-    # Stand-in: 200 uniform valid pixels / every 4th row of the valid pixels.
-    rng = np.random.default_rng(0)
-    out = np.zeros_like(sample.depth)
-    if kind == "indoor":
-        idx = np.flatnonzero(sample.valid)
-        idx = rng.choice(idx, size=min(200, idx.size), replace=False)
-        out.flat[idx] = sample.depth.flat[idx]
-    else:
-        out[::4] = sample.depth[::4]
-    return out
+    return sampler_from_spec("uniform:200" if kind == "indoor" else "lidar:hdl64")(sample)
 
 
 def coloured(depth: np.ndarray, vmax: float, cmap) -> np.ndarray:

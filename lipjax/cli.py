@@ -24,11 +24,11 @@ import argparse
 import sys
 
 from lipjax import __version__, console
-from lipjax.data.folder import parse_depth_scale
+from lipjax.data.folder import OUT_FORMATS, parse_depth_scale
 from lipjax.data.protocols import PROTOCOLS
 from lipjax.data.rendered import render_to_disk
 from lipjax.data.sources import NO_PROTOCOL, SOURCES
-from lipjax.data.synthetic import SYNTHETIC_KINDS
+from lipjax.data.synthetic import SPLITS, SYNTHETIC_KINDS
 from lipjax.evaluate import DEFAULT_COLUMNS, evaluate_methods, markdown_table, save_json
 from lipjax.export import export
 from lipjax.files import COMPLETE_HELP, READ_WORKERS, complete_files, project_file
@@ -150,7 +150,7 @@ def _add_complete_parser(sub) -> None:
                    help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also of .png output (default 256)")
     _add_model_args(c, f"shipped model (lipjax models), saved model path or classical fill ({', '.join(CLASSICAL)})")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
-    c.add_argument("--out-format", choices=("npy", "png", "color.png"), help="per-frame format with folder inputs")
+    c.add_argument("--out-format", choices=OUT_FORMATS, help="per-frame format with folder inputs")
     c.add_argument("--max-side", type=console.positive_int, metavar="N",
                    help="run frames downsized to this longer side (default: the working size of the samples)")
     c.add_argument("--color-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"),
@@ -196,7 +196,7 @@ def _add_evaluate_parser(sub) -> None:
     e.add_argument("--root", metavar="DIR",
                    help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
     e.add_argument("--raw-root", metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
-    e.add_argument("--split", choices=("train", "val", "test"), help="synthetic split (default test); FOLDER: "
+    e.add_argument("--split", choices=SPLITS, help="synthetic split (default test); FOLDER: "
                    "train or val as lipjax train splits it (default: every frame); --source: train|val (default val)")
     e.add_argument("--kind", choices=SYNTHETIC_KINDS, help="the scenes of --source synthetic (default indoor)")
     e.add_argument("--size", type=console.positive_int, nargs=2, metavar=("H", "W"), help="synthetic: default 256 320")
@@ -236,7 +236,7 @@ def _add_data_parser(sub) -> None:
     r = d.add_subparsers(dest="data_command", required=True, metavar="ACTION").add_parser(
         "render", help="render synthetic frames into shard files, in worker processes")
     r.add_argument("--kind", required=True, choices=SYNTHETIC_KINDS)
-    r.add_argument("--split", default="train", choices=("train", "val", "test"))
+    r.add_argument("--split", default="train", choices=SPLITS)
     r.add_argument("--count", type=console.positive_int, required=True, help="frames 0 .. N-1 of the split")
     r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
     r.add_argument("--height", type=console.positive_int, help="full frame (default 256x320 indoor, 128x416 outdoor)")
