@@ -13,14 +13,16 @@ from __future__ import annotations
 import argparse
 import sys
 
+from lipjax.console import ArgumentParser, one_line, run_main
 from lipjax.train.config import parse_overrides
 from lipjax.train.run import run
 from lipjax.utils import enable_compilation_cache
 
+PROG = f"python -m {__spec__.name}"  # as run: the same when imported
+
 
 def main(argv=None) -> None:
-    p = argparse.ArgumentParser(prog="train", description=__doc__,
-                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--config", required=True, help="a name of experiments.configs.CONFIGS")
     p.add_argument("--workdir", default=None, help="default: runs/<config>")
     p.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE", help="override a config field")
@@ -36,13 +38,12 @@ def main(argv=None) -> None:
 
     try:
         config = get_config(args.config, parse_overrides(args.set))
-    except ValueError as exc:
-        print(f"train: error: {exc}", file=sys.stderr)
-        raise SystemExit(2) from None
+    except ValueError as exc:  # an unknown config or field, or a bad value: a usage error
+        p.error(one_line(exc))
     enable_compilation_cache()
     run(config, args.workdir or f"runs/{args.config}", export=args.export, export_only=args.export_only,
         average=args.average, progress=not args.no_progress)
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_main(PROG, main))

@@ -3,7 +3,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
-                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--threads N]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--mirror] [--threads N]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
@@ -57,7 +57,7 @@ def _cmd_complete(args) -> int:
         depth_scale=args.depth_scale, model=args.model, iterations=args.iterations, max_side=args.max_side,
         out_format=args.out_format, color_range=args.color_range, ply=args.ply,
         intrinsics=args.intrinsics or args.intrinsics_file, uncertainty=args.uncertainty,
-        max_uncertainty=args.max_uncertainty, fill_all=args.fill_all, progress=not args.quiet,
+        max_uncertainty=args.max_uncertainty, fill_all=args.fill_all, mirror=args.mirror, progress=not args.quiet,
         log=None if args.quiet else console.say, workers=min(args.threads or READ_WORKERS, READ_WORKERS))
     if not args.quiet:
         console.say(done.summary())
@@ -65,10 +65,9 @@ def _cmd_complete(args) -> int:
 
 
 def _cmd_project(args) -> int:
-    written = project_file(args.rgb, args.lidar, args.calib, args.out, camera=args.camera,
-                           depth_scale=args.depth_scale)
+    done = project_file(args.rgb, args.lidar, args.calib, args.out, camera=args.camera, depth_scale=args.depth_scale)
     if not args.quiet:
-        console.say(written.summary())
+        console.say(done.summary())
     return 0
 
 
@@ -146,8 +145,8 @@ def _add_complete_parser(sub) -> None:
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
     c.add_argument("--depth", help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
     _add_lidar_args(c, required=False)
-    c.add_argument("--depth-scale", type=_depth_scale, metavar="S",
-                   help="PNG value per metre: 256 (kitti), 1000 (nyu), 5000 (tum); also of .png output (default 256)")
+    c.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="PNG value per metre: 256 (kitti), "
+                   "1000 (nyu), 5000 (tum); required by .png input (no default); .png output: 256 when not given")
     _add_model_args(c, f"shipped model (lipjax models), saved model path or classical fill ({', '.join(CLASSICAL)})")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, help="per-frame format with folder inputs")
@@ -161,6 +160,7 @@ def _add_complete_parser(sub) -> None:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
+    c.add_argument("--mirror", action="store_true", help="average with the mirror image's depth: better, 2x time")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")

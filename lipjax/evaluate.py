@@ -171,7 +171,7 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
       "val/: every frame", "val split: the last 5 % of the frames, as lipjax train holds them out", ...).
     """
     from lipjax.data.errors import dataset_error
-    from lipjax.data.folder import FolderDataset
+    from lipjax.data.folder import SPARSE_DIR, FolderDataset
     from lipjax.data.sampling import sampler_from_spec
     from lipjax.data.sources import (VAL_TAIL_FRACTION, FolderInput, Subset, folder_split_root, own_points,
                                      tail_split, uses_intrinsics)
@@ -179,12 +179,13 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
     if split not in (None, "train", "val"):
         raise ValueError(f"split must be None (every frame), 'train' or 'val', got {split!r}")
     folder, own_split = folder_split_root(Path(root), split or "val")
-    spec = sampler or (OWN_INPUT if (folder / "sparse").is_dir() else DEFAULT_SAMPLER)
+    own_dir = folder / SPARSE_DIR
+    spec = sampler or (OWN_INPUT if own_dir.is_dir() else DEFAULT_SAMPLER)
     own = spec.split(":")[0].strip() == OWN_INPUT
-    if own and not (folder / "sparse").is_dir():
-        raise dataset_error(f"sampler {spec!r} reads the folder's own sparse maps (sparse/<stem>.png|.npy, as "
+    if own and not own_dir.is_dir():
+        raise dataset_error(f"sampler {spec!r} reads the folder's own sparse maps ({SPARSE_DIR}/<stem>.png|.npy, as "
                             "depth/), and there are none; add them or use a sampler such as uniform:200, in",
-                            folder / "sparse")
+                            own_dir)
     has_intrinsics = (folder / "intrinsics.txt").is_file() or (folder / "intrinsics").is_dir()
     if uses_intrinsics(spec) and intrinsics is None and not has_intrinsics:
         raise dataset_error(f"sampler {spec!r} simulates a LiDAR and needs the camera intrinsics of the frames: "
@@ -192,7 +193,7 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
                             "intrinsics.txt (fx fy cx cy) in", folder)
     dataset = FolderDataset(folder, depth_scale, intrinsics, id_prefix=f"folder/{folder.name}",
                             intrinsics_needed=uses_intrinsics(spec))
-    draw = (FolderInput(os.fspath(folder / "sparse"), depth_scale, dataset.id_prefix, own_points(spec)) if own
+    draw = (FolderInput(os.fspath(own_dir), depth_scale, dataset.id_prefix, own_points(spec)) if own
             else sampler_from_spec(spec))
     if own_split:
         return dataset, draw, spec, f"{folder.name}/: every frame"

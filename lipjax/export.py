@@ -1,10 +1,13 @@
 """Exports a trained model for a fixed input shape: as serialised StableHLO (`jax.export`, here), or as one ONNX
 graph with the initial fill and the resizes inside (lipjax.onnx_export, for onnxruntime: the deployment format).
 
-    exported = export_completer(lipjax.load_model("lip-ad-indoor"), batch=1, height=480, width=640)
+    completer = lipjax.load_model("lip-ad-indoor")
+    exported = export_completer(completer, batch=1, height=480, width=640)
     save_exported(exported, "lip-ad-indoor_1x480x640.stablehlo")
     run = load_exported("lip-ad-indoor_1x480x640.stablehlo")
-    depth = run(rgb_uint8_bhw3, sparse_f32_bhw)                        # (B, H, W) float32 metres
+    kind = completer.config.initial_estimate                           # "linear": a fill computed on the host
+    z0 = lipjax.model.host_initial_estimate(kind, sparse_f32_bhw)      # (B, H, W) float32 metres
+    depth = run(rgb_uint8_bhw3, sparse_f32_bhw, z0)                    # (B, H, W) float32 metres
 
 or from the shell: `lipjax export --model lip-ad-indoor --height 480 --width 640 --out model.stablehlo`, which runs
 `export(model, out, height=..., width=...)`: the extension of `out` chooses the format (EXPORT_FORMATS: .stablehlo
@@ -18,9 +21,10 @@ Choices:
   - The signature is fixed: rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) in metres with 0 = no sample ->
     dense depth float32 (B, H, W) metres, clamped at 0 like `Completer.__call__`. B, H, W are those given at
     export; another size needs another export. Any H, W works (the network pads to a multiple of 8 inside).
-  - Models whose initial estimate is computed on the host (`initial_estimate="linear"` or `"nearest"`: a
+  - Models whose initial estimate is computed on the host (`initial_estimate="linear"`, `"nearest"` or `"auto"`: a
     Delaunay triangulation is not a jit-able program) take a third input z0 float32 (B, H, W) metres, that
-    fill of `sparse`: `lipjax.model.host_initial_estimate(kind, sparse)` or any equivalent implementation.
+    fill of `sparse`: `lipjax.model.host_initial_estimate(kind, sparse)` or any equivalent implementation. Every
+    shipped LIP model is one of them (`ExportedCompleter.needs_z0`); the others take `run(rgb, sparse)`.
   - No input checks run inside the exported program (a sparse map in millimetres or all zeros gives garbage,
     not an error); `load_exported`'s callable checks shapes and dtypes only. Use `lipjax.inputs.check_inputs`
     where lipjax is installed.
@@ -32,7 +36,7 @@ this package (`load_exported` is a convenience around exactly this):
 
     import jax, numpy as np
     exported = jax.export.deserialize(open("model.stablehlo", "rb").read())
-    depth = np.asarray(exported.call(rgb_uint8, sparse_f32))
+    depth = np.asarray(exported.call(rgb_uint8, sparse_f32, z0_f32))   # without z0 when len(exported.in_avals) == 2
 """
 from __future__ import annotations
 

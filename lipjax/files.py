@@ -12,7 +12,7 @@ A folder overlaps reading, the model and writing: worker threads read and decode
 numpy's file reads release the GIL) while the model runs on the current one in the calling thread, and one background
 thread post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is
 loaded once and compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames
-(`python benchmarks/folder_speed.py --keep DIR`, lip-any at 455x132) on the 2-core machine with nothing else
+(`python benchmarks/folder_speed.py --keep DIR`, lip-any at 132x455) on the 2-core machine with nothing else
 running, a folder ran at 0.86x the warm single-frame rate (median of 7 runs, 0.78-0.87; single frame 44-48 ms);
 with the same 2 cores shared with a training run (load average 6-9) at 0.72x (median of 15 runs). Per frame a
 folder adds 17.5 ms of CPU that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1;
@@ -43,7 +43,7 @@ from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, outp
                                 read_intrinsics, write_depth)
 from lipjax.data.lidar import read_lidar_frame
 from lipjax.data.sample import Intrinsics
-from lipjax.inference import Completer, complete_frame, frame_size
+from lipjax.inference import MIRROR_AVERAGE, Completer, complete_frame, frame_size
 from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
@@ -95,8 +95,8 @@ COMPLETE_HELP = """\
             XLA's threads; `taskset -c 0,1 lipjax ...` works as well and picks the cores.
 
 Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
-in training, at most 60,000 pixels for LiDAR scan lines (200 points on 640x480 run at 261x196; a 64-beam KITTI
-scan at 455x132; dense scattered samples at full size); a
+in training, at most 60,000 pixels for LiDAR scan lines (sizes HxW: 200 points on 480x640 run at 196x261; a
+64-beam KITTI scan at 132x455; dense scattered samples at full size); a
 new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
 pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
 averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured values
@@ -309,13 +309,14 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
         log(f"model: {completer.name}, the default for {scene} input ({why}); choose another with --model")
     h, w = frame_size(completer, sparse, max_side)
     if max_side is None and h * w > inference.LARGE_FRAME_PIXELS:  # read here: tests lower it
-        warnings.warn(f"{rgb_file}: a {sparse.shape[1]}x{sparse.shape[0]} frame ({sparse.size / 1e6:.1f} Mpixel) "
+        warnings.warn(f"{rgb_file}: a {sparse.shape[0]}x{sparse.shape[1]} frame ({sparse.size / 1e6:.1f} Mpixel) "
                       "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized", stacklevel=2)
     return completer
 
 
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
-         max_side: int | None, progress: bool, log: Callable[[str], None] | None, workers: int) -> None:
+         max_side: int | None, mirror: bool, progress: bool, log: Callable[[str], None] | None,
+         workers: int) -> None:
     """Reads (prefetched), completes (this thread) and writes (`_Writer`) every job of the plan, in order. The
     model is loaded after the first frame is read (input errors come before the slow model load); the progress
     bar starts after the line naming it."""
@@ -330,7 +331,8 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
                     output.max_depth_m = model_max_depth(completer)
                     bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
                                disable=not progress or len(plan.jobs) < 2)
-                writer.submit(job, rgb, sparse, complete_frame(completer, rgb, sparse, max_side), intrinsics)
+                dense = complete_frame(completer, rgb, sparse, max_side, mirror=mirror)
+                writer.submit(job, rgb, sparse, dense, intrinsics)
                 bar.update()
     finally:
         if bar is not None:
@@ -340,7 +342,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
 def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike, *,
                    lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
                    depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
-                   max_side: int | None = None, out_format: str | None = None,
+                   max_side: int | None = None, mirror: bool = MIRROR_AVERAGE, out_format: str | None = None,
                    color_range: tuple[float, float] | None = None, ply: str | os.PathLike | None = None,
                    intrinsics: IntrinsicsLike | str | os.PathLike | None = None,
                    uncertainty: str | os.PathLike | None = None, max_uncertainty: float | None = None,
@@ -355,6 +357,8 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
         `color_range` metres, by default fitted to the first frame), or a folder with `out_format`.
       model, iterations: anything lipjax.methods.get_completer takes; None: the default of the first frame.
       max_side: run frames downsized to this longer side, pixels (default: the working size of the samples).
+      mirror: average a learned model's estimate with that of the mirror-image frame (lipjax.inference.mirror_averaged:
+        more accurate, twice the model's time).
       ply, intrinsics: also write a coloured point cloud (metres), with the RGB camera's intrinsics (pixels: an
         Intrinsics, (fx, fy, cx, cy), K, or a file lipjax.data.folder.read_intrinsics reads; a sweep's calibration
         gives them otherwise).
@@ -395,7 +399,7 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
 
     output = _Output(plan.fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, tuple(color_range) if color_range else None,
                      fill_all, max_uncertainty)
-    _run(plan, read, output, model, iterations, max_side, progress, log, workers)
+    _run(plan, read, output, model, iterations, max_side, mirror, progress, log, workers)
     return Completed([j.out for j in plan.jobs], [j.ply for j in plan.jobs if j.ply], Path(out),
                      time.perf_counter() - start, output.unsupported / output.pixels if output.pixels else 0.0,
                      output.color_range if output.fitted else None)

@@ -112,6 +112,14 @@ def default_model(scene: str = "indoor") -> Completer:
     return Completer.random()
 
 
+# Whether the default path (`complete_at`, `lipjax.complete`, `lipjax complete`, the ONNX graph) averages a learned
+# model's estimate with that of the mirror-image frame (`mirror_averaged`). Off: with the shipped lip-any it is more
+# accurate (`benchmarks/generalisation.py --frames 8`: 0.7755 -> 0.7661 x linear, every setting better but far
+# views, 0.958 -> 0.964) but takes twice the model's time (benchmarks/speed.py: 480x640 with 200 points 62 -> 117
+# ms, 17.7 -> 9.6 frames/s normalised; 352x1216 with 64 beams 75 -> 139 ms), below the 10 frames/s the default
+# path keeps. Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
+MIRROR_AVERAGE = False
+
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
 LARGE_FRAME_PIXELS = 2_000_000
 
@@ -152,17 +160,27 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
     return working_size(shape, spacing, scan_lines=is_lidar_pattern(sparse_m))
 
 
-def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None) -> np.ndarray:
+def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
+                   mirror: bool = MIRROR_AVERAGE) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`)."""
-    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side))
+    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror)
 
 
-def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray) -> np.ndarray:
+    """(z(I, y) + flip(z(flip(I), flip(y)))) / 2 for one frame, rgb (h, w, 3) and sparse (h, w) metres: the model's
+    estimate averaged with its estimate of the mirror-image frame, flipped back (one batched call)."""
+    both = completer(np.stack([rgb, rgb[:, ::-1]]), np.stack([sparse_m, sparse_m[:, ::-1]]))
+    return 0.5 * (both[0] + both[1][:, ::-1])
+
+
+def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
+                mirror: bool = MIRROR_AVERAGE) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear). Then the final x-update runs at full size: with rho -> 0 at the
     measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value.
+    With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why).
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
     bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
     linear on 352x1216 streets with 64 beams.)
@@ -176,10 +194,11 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     rgb, sparse_m = rgb[0], sparse[0]
     big_h, big_w = sparse_m.shape
     h, w = size
+    run = functools.partial(mirror_averaged, completer) if mirror and isinstance(completer, Completer) else completer
     if (h, w) == (big_h, big_w):
-        return np.asarray(completer(rgb, sparse_m), np.float32)
+        return np.asarray(run(rgb, sparse_m), np.float32)
     small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-    small = np.asarray(completer(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
+    small = np.asarray(run(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
     dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]

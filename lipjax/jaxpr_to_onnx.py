@@ -203,6 +203,13 @@ def _slice(g: _Graph, eqn, ins):
     return g.node("Slice", [ins[0], _i64(start), _i64(limit), _i64(range(len(start))), _i64(steps)])
 
 
+def _rev(g: _Graph, eqn, ins):
+    """lax.rev (x[..., ::-1] on `dimensions`): a Slice with step -1 from the last element past the first."""
+    axes = list(eqn.params["dimensions"])
+    last, past_first, step = [-1] * len(axes), [np.iinfo(np.int64).min] * len(axes), [-1] * len(axes)
+    return g.node("Slice", [ins[0], _i64(last), _i64(past_first), _i64(axes), _i64(step)])
+
+
 def _pad(g: _Graph, eqn, ins):
     config = eqn.params["padding_config"]
     if any(interior for _, _, interior in config):
@@ -346,8 +353,8 @@ PRIMITIVES: dict[str, Handler] = {
     "is_finite": _is_finite,
     "convert_element_type": _convert, "select_n": _select_n, "clamp": _clamp,
     "reshape": _reshape, "squeeze": _reshape, "expand_dims": _reshape, "broadcast_in_dim": _broadcast_in_dim,
-    "transpose": _transpose, "slice": _slice, "pad": _pad, "concatenate": _concatenate, "stack": _stack,
-    "split": _split, "reduce_sum": _reduce, "reduce_max": _reduce, "reduce_min": _reduce,
+    "transpose": _transpose, "slice": _slice, "rev": _rev, "pad": _pad, "concatenate": _concatenate,
+    "stack": _stack, "split": _split, "reduce_sum": _reduce, "reduce_max": _reduce, "reduce_min": _reduce,
     "argmin": _arg_reduce, "argmax": _arg_reduce, "cumsum": _cumulative,
     "conv_general_dilated": _conv, "reduce_window_max": _reduce_window, "reduce_window_min": _reduce_window,
     "reduce_window_sum": _reduce_window, "gather": _gather, "dot_general": _dot_general,

@@ -78,9 +78,14 @@ class LIPConfig(LearnedModel):
     iterative = True  # lipjax.interfaces.LearnedModel: num_iterations, trajectories
 
     def init(self, key: jax.Array) -> "Params":
+        """Random parameters for this config from a jax.random key (module function `init`): the pytree of the
+        module docstring; their shapes do not depend on the image size."""
         return init(self, key)
 
     def apply(self, params, rgb, sparse, weights=None, *, return_trajectory: bool = False, z0=None):
+        """(depth (B, H, W) float32 metres, Trajectory or None) from rgb (B, H, W, 3) uint8 or float in [0, 1] and
+        sparse (B, H, W) float32 metres (0 = no sample); weights (B, H, W) >= 0, z0 (B, H, W) metres for a host
+        initial estimate (`host_inputs`). Jit-able, no input checks: the module function `apply`."""
         return apply(self, params, rgb, sparse, weights, z0=z0, return_trajectory=return_trajectory)
 
     @property

@@ -135,7 +135,7 @@ def default_mark(defaults: dict[str, str], name: str) -> str:
 def table(defaults: dict[str, str]) -> str:
     """The shipped models as a text table in aligned columns (TABLE_COLUMNS), one row per model, from each model's
     config and metadata: DEFAULT names the scene(s) whose default it is (`default_mark`; `defaults`: scene ->
-    name, e.g. lipjax.inputs.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
+    name, e.g. lipjax.shipped.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
     type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
     (its sampler); "-" where unknown or not applicable."""
     rows = [TABLE_COLUMNS]
@@ -162,10 +162,11 @@ def listing() -> str:
     if not available():
         return (f"no shipped models in {WEIGHTS_DIR}; `lipjax complete` then uses an untrained model. Train one "
                 "with `python -m experiments.train --config lip_cnn_indoor`, or pass --model PATH.")
-    return (table(DEFAULT_MODELS) + "\n\nDEFAULT: the inputs lipjax complete gives the model (indoor: scattered "
-            "samples; outdoor: LiDAR scan lines\nor a median sample depth over "
-            f"{OUTDOOR_MEDIAN_M:g} m); --model NAME overrides it. "
-            "TYPE: LIP and its prox, or an end-to-end network.")
+    return (table(DEFAULT_MODELS) + "\n\nDEFAULT: the inputs lipjax complete gives the model: indoor (scattered "
+            f"samples), outdoor (LiDAR scan lines or a\nmedian sample depth over {OUTDOOR_MEDIAN_M:g} m) or all "
+            "(every input); --model NAME overrides it. TYPE: LIP and its prox, or an\nend-to-end network. VAL RMSE: "
+            "on the model's own validation frames (VALIDATED ON); for a model of rooms and streets\n(both samplers "
+            "named) rooms and streets together, so it is not comparable with the RMSE of a model of one scene.")
 
 
 def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:

@@ -43,6 +43,7 @@ computation in XLA, which fuses the element-wise operations that onnxruntime run
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import pathlib
@@ -52,7 +53,7 @@ import jax.numpy as jnp
 
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import Completer
+from lipjax.inference import MIRROR_AVERAGE, Completer
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import working_size
@@ -93,9 +94,11 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
     return low, high
 
 
-def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int]):
+def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int], *,
+                    mirror: bool = MIRROR_AVERAGE):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
-    graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX."""
+    graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
+    average with the mirror-image frame as lipjax.complete does (lipjax.inference.MIRROR_AVERAGE)."""
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
     unknown = set(config.host_input_names) - {"z0"}
@@ -103,11 +106,19 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
         raise ValueError(f"{completer.name} needs host inputs {sorted(unknown)} that have no in-graph version")
     resized = tuple(working) != tuple(frame)
 
+    def model(rgb, sparse):
+        extra = {name: jump_flood_nearest(sparse) for name in config.host_input_names}
+        return jnp.maximum(config.apply(params, rgb, sparse, **extra)[0], 0.0)
+
     def run(rgb, sparse):
         small_rgb, small = (resize_area_uint8(rgb, working) / 255.0, reproject_nearest(sparse, working)) if resized \
             else (rgb, sparse)
-        extra = {name: jump_flood_nearest(small) for name in config.host_input_names}
-        depth = jnp.maximum(config.apply(params, small_rgb, small, **extra)[0], 0.0)
+        if mirror:  # lipjax.inference.mirror_averaged, the batch and its mirror images in one call
+            flip = functools.partial(jnp.flip, axis=2)
+            both = model(jnp.concatenate([small_rgb, flip(small_rgb)]), jnp.concatenate([small, flip(small)]))
+            depth = 0.5 * (both[:len(small)] + flip(both[len(small):]))
+        else:
+            depth = model(small_rgb, small)
         return jnp.where(sparse > 0, sparse, resize_bilinear(depth, frame)) if resized else depth
 
     return run
@@ -162,10 +173,10 @@ def need_onnx() -> None:
 
 
 def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
-                samples: int | None = None, scan_lines: bool = True) -> OnnxFile:
+                samples: int | None = None, scan_lines: bool = True, mirror: bool = MIRROR_AVERAGE) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
-    `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`. ImportError without the
-    onnx package."""
+    `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`; `mirror` as
+    lipjax.complete(..., mirror=True). ImportError without the onnx package."""
     need_onnx()
     import onnx
 
@@ -179,11 +190,12 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
     metadata = {"lipjax_model": completer.name, "units": "metres; sparse 0 = no sample",
                 "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
                 "working_size_samples": f"{interval[0]}-{interval[1]}" + ("" if scan_lines else " scattered"),
-                "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else "")}
+                "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else ""),
+                "mirror_averaged": str(bool(mirror)).lower()}
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
-    model = jaxpr_to_onnx.convert(inference_graph(completer, (height, width), working), specs, INPUT_NAMES,
-                                  OUTPUT_NAMES, metadata, doc=__doc__.split("\n")[0])
+    graph = inference_graph(completer, (height, width), working, mirror=mirror)
+    model = jaxpr_to_onnx.convert(graph, specs, INPUT_NAMES, OUTPUT_NAMES, metadata, doc=__doc__.split("\n")[0])
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     onnx.save(model, os.fspath(path))

@@ -26,7 +26,7 @@ The constants were chosen on synthetic renders larger than the training frames (
 benchmarks/working_resolution.py --model lip-any --frames 6`, geometric-mean RMSE ratio to the full-size linear fill
 over 50 to 5,000 points on 480x640 rooms and 200 or 25,000 points on 352x1216 streets for T and the scattered cap;
 over 64- and 32-beam scans on those streets for the scan-line cap), as the most accurate rule whose frames meet the
-speed target of 10 frames/s (normalised to 195 GFLOP/s, benchmarks/speed.py) at 640x480 with 200 points and at
+speed target of 10 frames/s (normalised to 195 GFLOP/s, benchmarks/speed.py) at 480x640 with 200 points and at
 352x1216 with 64 beams. Unconstrained, the best were T=22 px without a cap for scattered samples (0.813) and a
 100,000-pixel cap for scan lines (0.697), but those frames took 49 and 45 ms (8.8 and 9.7 frames/s normalised);
 the rule's T=16 px (0.816) and 60,000 pixels (0.701) are within 0.6 % of them. The earlier rule, one cap of 60,000
@@ -50,8 +50,8 @@ MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cos
 def sample_spacing_px(sparse_m: np.ndarray) -> float:
     """Mean spacing of the samples of a (H, W) sparse depth map (0 = none), in pixels: sqrt(H W / n); inf for n = 0.
 
-    Over the whole frame (TARGET_SPACING_PX was chosen by it); lipjax.uncertainty.sample_spacing is the spacing within
-    the samples' bounding box (where a scan's samples are), for the support rules."""
+    Over the whole frame (TARGET_SPACING_PX was chosen by it); lipjax.uncertainty.box_sample_spacing_px is the
+    spacing within the samples' bounding box (where a scan's samples are), for the support rules."""
     n = int(np.count_nonzero(np.asarray(sparse_m) > 0))
     h, w = np.shape(sparse_m)[-2:]
     return math.sqrt(h * w / n) if n else math.inf

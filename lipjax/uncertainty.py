@@ -54,8 +54,9 @@ points: s = 35 px; KITTI, HDL-64 pattern: s = 6.4 px) no NYU pixel below the top
 of a KITTI frame's pixels are (holes in the scan), of which about 1 in 100 has ground truth."""
 
 
-def sample_spacing(sparse: np.ndarray) -> float:
-    """Typical distance between samples in pixels (>= 1): sqrt(bounding-box area / number of samples).
+def box_sample_spacing_px(sparse: np.ndarray) -> float:
+    """Typical distance between the samples of an (H, W) sparse map (metres, 0 = none) in pixels (>= 1):
+    sqrt(area of their bounding box / their number), within that box.
 
     Not lipjax.resolution.sample_spacing_px, which spreads the samples over the whole frame (sqrt(H W / n)) to
     choose the working size: this is their spacing where they are, the unit of the support rules and of the gains
@@ -96,7 +97,7 @@ def support_features(sparse: np.ndarray) -> dict[str, np.ndarray | float]:
     sparse = np.asarray(sparse, np.float32)
     if sparse.ndim != 2:
         raise ValueError(f"sparse depth must be (H, W), got shape {sparse.shape}")
-    s = sample_spacing(sparse)
+    s = box_sample_spacing_px(sparse)
     measured = sparse > 0
     distance, (ri, ci) = ndimage.distance_transform_edt(~measured, return_indices=True)
     nearest = sparse[ri, ci]
@@ -142,12 +143,12 @@ def support_mask(sparse: np.ndarray) -> np.ndarray:
     """(H, W) bool, True where the samples of an (H, W) sparse map (metres, 0 = no sample) support a completed
     depth; or (B, H, W) for a batch.
 
-    With s the sample spacing in pixels (`sample_spacing`: sqrt(area of the samples' bounding box / number of
+    With s the sample spacing in pixels (`box_sample_spacing_px`: sqrt(area of the samples' bounding box / number of
     samples)), a pixel has NO support when it is
       - more than ABOVE_SPACINGS * s pixels (1 s) above the highest sample of its column, the highest within
         about 2 s columns either side (the sky, anything above the top LiDAR beam); or
       - farther than REACH_SPACINGS * s pixels (3 s) from every sample (Euclidean; a hole in the scan, a corner).
-    So 200 points on a 640x480 frame (s = 35 px) reach 105 px, and a 64-beam scan of a KITTI frame (s = 6.4 px)
+    So 200 points on a 480x640 frame (s = 35 px) reach 105 px, and a 64-beam scan of a KITTI frame (s = 6.4 px)
     19 px. Measured pixels always have support. The rule reads the sample positions only, never the depth.
 
     Both limits are decided in integers, exactly (s ** 2 = area / n is a fraction): a height of t pixels is within

@@ -1,6 +1,8 @@
 """LiDAR sweep -> sparse depth: calibration readers of every format, point cloud files, and the projection checked
 against the devkit's own formula (P2 @ R0_rect @ Tr_velo_to_cam in homogeneous coordinates) on a generated rig
 whose calibration files the tests write in KITTI's text formats."""
+import pathlib
+
 import numpy as np
 import pytest
 
@@ -92,6 +94,26 @@ def test_every_format_gives_the_rigs_intrinsics_and_transform(tmp_path):
     for camera in (0, 3):
         np.testing.assert_allclose(read_calibration(obj, camera)[1], _cam_from_velo(camera), atol=1e-12)
         np.testing.assert_allclose(read_calibration(raw, camera)[1], _cam_from_velo(camera), atol=1e-12)
+
+
+# docs/usage.md's own-rig example, verbatim: numbers spaced in groups, and a "#" comment after each line.
+RIG_EXAMPLE = """\
+K: 721.5 0 609.6  0 721.5 172.9  0 0 1        # or  intrinsics: fx fy cx cy
+T_cam_from_lidar: 0 -1 0 0.06  0 0 -1 -0.08  1 0 0 -0.27    # 3x4 or 4x4, row-major: p_cam = R p_lidar + t
+"""
+
+
+@pytest.mark.parametrize("name", ["rig.txt", "rig.yaml"])
+def test_the_docs_rig_example_reads_as_text_and_as_yaml(tmp_path, name):
+    """The own-rig calibration of docs/usage.md, written as it stands there into a .txt and a .yaml file: the
+    trailing comments are dropped, and YAML's strings of numbers read as the numbers."""
+    usage = (pathlib.Path(__file__).parents[1] / "docs" / "usage.md").read_text()
+    assert RIG_EXAMPLE in usage, "docs/usage.md's rig example changed: update RIG_EXAMPLE"
+    (tmp_path / name).write_text(RIG_EXAMPLE)
+    intrinsics, t = read_calibration(tmp_path / name)
+    assert (intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy) == (721.5, 721.5, 609.6, 172.9)
+    expected = [[0, -1, 0, 0.06], [0, 0, -1, -0.08], [1, 0, 0, -0.27], [0, 0, 0, 1]]
+    np.testing.assert_array_equal(t, expected)
 
 
 def test_projection_agrees_pixel_for_pixel_with_the_devkit_formula(tmp_path):

@@ -77,7 +77,7 @@ def test_png_in_png_out_same_scale_equals_library(model, frame, tmp_path):
     assert _complete(model, frame, tmp_path / "out.png", depth="png") == 0
     raw = cv2.imread(str(tmp_path / "out.png"), cv2.IMREAD_UNCHANGED)
     assert raw.dtype == np.uint16 and raw.shape == (H, W)
-    expected = model[1](frame["rgb_array"], frame["sparse_array"])
+    expected = complete_frame(model[1], frame["rgb_array"], frame["sparse_array"])
     np.testing.assert_array_equal(raw, np.round(expected * SCALE).astype(np.uint16))
 
 
@@ -85,7 +85,14 @@ def test_npy_in_npy_out_metres_equals_library(model, frame, tmp_path):
     assert _complete(model, frame, tmp_path / "out.npy") == 0
     out = np.load(tmp_path / "out.npy")
     assert out.dtype == np.float32 and out.shape == (H, W)
-    np.testing.assert_allclose(out, model[1](frame["rgb_array"], frame["sparse_array"]), rtol=1e-6)
+    np.testing.assert_allclose(out, complete_frame(model[1], frame["rgb_array"], frame["sparse_array"]), rtol=1e-6)
+
+
+def test_mirror_flag_equals_the_library_with_mirror(model, frame, tmp_path):
+    assert _complete(model, frame, tmp_path / "out.npy", "--mirror") == 0
+    out, rgb, sparse = np.load(tmp_path / "out.npy"), frame["rgb_array"], frame["sparse_array"]
+    np.testing.assert_allclose(out, complete_frame(model[1], rgb, sparse, mirror=True), rtol=1e-6)
+    assert np.abs(out - complete_frame(model[1], rgb, sparse)).max() > 1e-3
 
 
 def test_color_png_and_ply_outputs(model, frame, tmp_path):
@@ -94,7 +101,7 @@ def test_color_png_and_ply_outputs(model, frame, tmp_path):
     assert rc == 0
     picture = cv2.imread(str(tmp_path / "out.color.png"), cv2.IMREAD_UNCHANGED)
     assert picture.dtype == np.uint8 and picture.shape == (H, W, 3)
-    expected = model[1](frame["rgb_array"], frame["sparse_array"])
+    expected = complete_frame(model[1], frame["rgb_array"], frame["sparse_array"])
     np.testing.assert_array_equal(picture[..., ::-1], viz.colorize_depth(expected, 0, 6))
     header = (tmp_path / "cloud.ply").read_bytes().split(b"end_header\n")[0].decode()
     assert f"element vertex {np.count_nonzero(expected > 0)}" in header and "binary_little_endian" in header
@@ -111,7 +118,8 @@ def test_folder_batch_pairs_frames_by_trailing_number(model, tmp_path):
     assert rc == 0
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["rgb_00002.npy", "rgb_00010.npy"]
     for i, (rgb, sparse) in frames.items():
-        np.testing.assert_allclose(np.load(tmp_path / "out" / f"rgb_{i:05d}.npy"), model[1](rgb, sparse), rtol=1e-6)
+        expected = complete_frame(model[1], rgb, sparse)
+        np.testing.assert_allclose(np.load(tmp_path / "out" / f"rgb_{i:05d}.npy"), expected, rtol=1e-6)
 
 
 def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, tmp_path):
@@ -212,7 +220,8 @@ def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_
                    "--ply", str(tmp_path / "a.ply"), "-q"])
     assert rc == 0
     sparse, _ = project_sweep(tmp_path / "sweep.npy", calib, (40, 120))
-    expected = mask_unsupported(model[1](rgb, sparse), sparse)  # 0 above the scan: lipjax complete's default
+    # 0 above the scan: lipjax complete's default
+    expected = mask_unsupported(complete_frame(model[1], rgb, sparse), sparse)
     np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-6)
     np.save(tmp_path / "sparse.npy", sparse)
     for ply, intrinsics in (("b.ply", ["--intrinsics", str(FX), str(FY), str(CX), str(CY)]),
@@ -251,7 +260,7 @@ def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsy
     args = ["complete", "--rgb", rgb_path, "--depth", npy, "--model", model[0], "--out", str(out)]
     assert cli.main(args) == 0
     with pytest.warns(UserWarning, match="beyond the 10 m range"):
-        dense = mask_unsupported(model[1](rgb, sparse * 8), sparse * 8)
+        dense = mask_unsupported(complete_frame(model[1], rgb, sparse * 8), sparse * 8)
     top = np.percentile(dense[dense > 0], 99)
     assert top > model[1].config.max_depth_m == 10  # beyond the model's range: the colours fit the output
     np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, top))
@@ -384,7 +393,7 @@ def test_subprocess_error_has_no_traceback(tmp_path):
 
 
 def test_models_command_is_a_table_in_aligned_columns_marking_every_default(capsys):
-    from lipjax.inputs import DEFAULT_MODELS
+    from lipjax.shipped import DEFAULT_MODELS
 
     assert cli.main(["models"]) == 0
     lines = capsys.readouterr().out.splitlines()

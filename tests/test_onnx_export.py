@@ -44,7 +44,7 @@ def _kitchen_sink(x, u8, idx):
     mat = jnp.einsum("bhwc,cd->bhwd", y, kernel[0, 0]) @ jnp.ones((4, 2))
     return (conv.transpose(0, 3, 1, 2).reshape(2, -1).sum(axis=1) + stacked.sum(axis=(1, 2)),
             win.astype(jnp.float32) + (u8 > 100), jnp.concatenate([taken, padded[:, :, :5]], axis=1),
-            mat, jnp.argmax(y, axis=2).astype(jnp.float32))
+            mat + jnp.flip(mat, axis=(1, 2)), jnp.argmax(y, axis=2).astype(jnp.float32))
 
 
 def test_each_primitive_computes_what_jax_computes():
@@ -137,3 +137,23 @@ def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_pa
     name = "--samples" if "samples" in option else "--scattered"
     with pytest.raises(ValueError, match=f"^{name} applies to .onnx exports only; drop it"):
         export("linear", tmp_path / "m.stablehlo", height=8, width=8, **option)
+
+
+def test_a_mirror_averaged_export_equals_complete_with_mirror(auto_model, tmp_path):
+    """export_onnx(mirror=True) holds the frame and its mirror image in one batch (lax.rev as ONNX Slice with step
+    -1) and equals lipjax.complete(..., mirror=True), which differs from the plain export."""
+    b, h, w = 2, 48, 64
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b, mirror=True)
+    plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b)
+    rng = np.random.default_rng(6)
+    rgb = rng.integers(0, 256, (b, h, w, 3), dtype=np.uint8)
+    sparse = np.zeros((b, h, w), np.float32)
+    sparse[:, 1::3] = np.where(rng.random((b, 16, w)) < 0.7, rng.uniform(2, 9, (b, 16, w)), 0)
+    got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
+    expected = np.stack([lipjax.complete(c, s, model=auto_model, mirror=True) for c, s in zip(rgb, sparse)])
+    np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
+    without, = _run_onnx(str(plain.path), rgb=rgb, sparse=sparse)
+    assert np.abs(got - without).max() > 1e-3
+    import onnx
+
+    assert {p.key: p.value for p in onnx.load(str(written.path)).metadata_props}["mirror_averaged"] == "true"

@@ -356,18 +356,18 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
 
 def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_and_validates_at_0_and_the_end(
         tmp_path, capsys, monkeypatch):
-    """Without --init, `lipjax train` fine-tunes the default model of the frames' scene (lipjax.inputs.DEFAULT_MODELS,
+    """Without --init, `lipjax train` fine-tunes the default model of the frames' scene (lipjax.shipped.DEFAULT_MODELS,
     here a tiny stand-in) and says so in one line; no intrinsics are needed for point samplers; the validation score
     of the starting model (step 0) and of the result are printed and logged; the model and the run are named after
     --out."""
-    import lipjax.inputs
+    import lipjax.shipped
     from lipjax import cli, model_io
     from lipjax.train.folder import default_init, folder_config
     from lipjax.train.run import logged_validation
 
     stem = tmp_path / "tiny"
     model_io.save(stem, CONFIG.model, init_state(CONFIG).g_params)
-    monkeypatch.setitem(lipjax.inputs.DEFAULT_MODELS, "indoor", str(stem))
+    monkeypatch.setitem(lipjax.shipped.DEFAULT_MODELS, "indoor", str(stem))
     root = make_folder(tmp_path / "folder")
     (root / "intrinsics.txt").unlink()
     out = tmp_path / "models" / "mine"

@@ -249,6 +249,20 @@ def test_train_command_errors_are_one_line(args, message, capsys):
         train_command.main(args)
     err = capsys.readouterr().err.strip()
     assert exit_.value.code == 2 and message in err and len(err.splitlines()) == 1
+    assert err.startswith(f"{train_command.PROG}: error: "), err
+
+
+def test_train_command_without_its_data_set_is_one_line(tmp_path, capsys):
+    """A missing data set, as the lipjax CLI reports one: "PROG: error: ..." on one line, exit status 1."""
+    from experiments import train as train_command
+    from lipjax.console import run_main
+
+    argv = ["--config", "lip_cnn_nyu", "--set", f"data.root={tmp_path / 'no-nyu'}", "--workdir",
+            str(tmp_path / "run"), "--no-progress"]
+    assert run_main(train_command.PROG, train_command.main, argv) == 1
+    lines = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith(f"{train_command.PROG}: error: NYU Depth v2 'val' split not "
+                                                   "found"), lines
 
 
 def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[int], list[int], list[int], str]:

@@ -20,7 +20,7 @@ def _grid_frame():
 
 def test_value_by_hand_and_zero_on_measured_pixels():
     sparse, depth = _grid_frame()
-    assert uncertainty.sample_spacing(sparse) == pytest.approx(7.0)
+    assert uncertainty.box_sample_spacing_px(sparse) == pytest.approx(7.0)
     u = expected_error(sparse, depth)
     # (5, 5): nearest sample at sqrt(50) px = sqrt(50) / 7 spacings; the 29-px window sees both depths: spread 2 m
     assert u[5, 5] == pytest.approx(SPREAD_GAIN * math.sqrt(50) / 7 * 2.0, rel=1e-5)
@@ -48,7 +48,7 @@ def _lidar_frame():
 def test_above_the_top_scan_line_is_the_most_uncertain():
     sparse, depth = _lidar_frame()
     u = expected_error(sparse, depth)
-    s = uncertainty.sample_spacing(sparse)
+    s = uncertainty.box_sample_spacing_px(sparse)
     above = np.arange(60)[:, None].repeat(80, 1) < 30 - s
     below = np.arange(60)[:, None].repeat(80, 1) >= 30
     assert u[above].min() >= u[~above].max()
@@ -222,7 +222,7 @@ def test_support_mask_follows_its_rule_in_pixels():
     sparse = np.zeros((60, 60), np.float32)
     sparse[20::2, ::2] = 7.0
     sparse[30:50, 10:50] = 0.0  # a hole in the scan: 20 rows, 40 columns
-    s = uncertainty.sample_spacing(sparse)
+    s = uncertainty.box_sample_spacing_px(sparse)
     mask = uncertainty.support_mask(sparse)
     np.testing.assert_array_equal(mask, _support_by_hand(sparse))
     assert s == pytest.approx(math.sqrt(39 * 59 / np.count_nonzero(sparse))) and 3 * s == pytest.approx(7.2, abs=0.1)

@@ -41,15 +41,16 @@ RAW_FILES = ("calib_velo_to_cam.txt", "calib_cam_to_cam.txt")
 
 def read_key_values(path: str | os.PathLike, layout: str = "", source: str = "") -> dict[str, np.ndarray]:
     """{key: float64 numbers} of a "key: n n n ..." text file; the colon may be missing (KITTI tracking:
-    "R_rect 1 0 0 ..."); lines whose values are not all numbers (e.g. "calib_time: 09-Jan-2012") are skipped.
-    An unreadable file raises DatasetError with `layout` and `source` (lipjax.data.errors)."""
+    "R_rect 1 0 0 ..."); a "#" starts a comment, to the end of its line; lines whose values are not all numbers
+    (e.g. "calib_time: 09-Jan-2012") are skipped. An unreadable file raises DatasetError with `layout` and
+    `source` (lipjax.data.errors)."""
     try:
         text = Path(path).read_text()
     except (OSError, UnicodeDecodeError) as exc:
         raise dataset_error(f"Cannot read calibration ({exc})", path, layout, source) from None
     rows = {}
     for line in text.splitlines():
-        key, _, values = line.replace(":", " ", 1).strip().partition(" ")
+        key, _, values = line.partition("#")[0].replace(":", " ", 1).strip().partition(" ")
         if not key:
             continue
         try:
@@ -122,16 +123,23 @@ def read_kitti_raw_calib(folder: str | os.PathLike, camera: int = 2) -> tuple[In
     return _with_offset(p, rigid(r_rect) @ rigid(r, t), cam_path)
 
 
+def _yaml_numbers(value) -> np.ndarray:
+    """The float64 numbers of a YAML value: a list (nested or flat), or one string of whitespace-separated numbers
+    ("721.5 0 609.6 ...", as in a text rig file); ValueError when any is not a number."""
+    return np.asarray(value.split() if isinstance(value, str) else value, np.float64).ravel()
+
+
 def read_rig_calib(path: str | os.PathLike) -> tuple[Intrinsics, np.ndarray]:
     """(intrinsics, (4, 4) T_cam_from_lidar, metres) of a plain rig file, "key: numbers" text or YAML (nested
-    lists or flat), with K (9 numbers) or intrinsics (fx fy cx cy), and T_cam_from_lidar (3x4 or 4x4)."""
+    lists, flat lists or a string of numbers), with K (9 numbers) or intrinsics (fx fy cx cy), and
+    T_cam_from_lidar (3x4 or 4x4); "#" starts a comment in either."""
     path = Path(path)
     if path.suffix.lower() in (".yaml", ".yml"):
         import yaml
 
         try:
             loaded = yaml.safe_load(path.read_text())
-            rows = {str(k): np.asarray(v, np.float64).ravel() for k, v in dict(loaded).items()
+            rows = {str(k): _yaml_numbers(v) for k, v in dict(loaded).items()
                     if k in ("K", "intrinsics", "T_cam_from_lidar")}
         except (OSError, yaml.YAMLError, TypeError, ValueError) as exc:
             raise dataset_error(f"Cannot read YAML calibration ({type(exc).__name__}: {exc})".replace("\n", " "),

@@ -5,9 +5,14 @@ Folder layout (frames matched by file stem):
     <root>/rgb/<stem>.png|.jpg|.jpeg          colour image (any bit depth; read as 8-bit RGB)
     <root>/depth/<stem>.png                   16-bit depth, metres = value / depth_scale, 0 = invalid
     <root>/depth/<stem>.npy                   float depth in metres (0 = invalid)
+    <root>/sparse/<stem>.png|.npy             optional: your own sparse input, as depth/ (the "input" sampler,
+                                          lipjax.data.sources.FolderInput; SPARSE_DIR)
     <root>/intrinsics.txt                     optional: "fx fy cx cy", the 9 numbers of K (row-major), the 12 of
-                                          a 3x4 P, or a calibration file (lipjax.data.calib: KITTI, any rig)
+                                          a 3x4 P, or a calibration file (lipjax.data.calib: KITTI, any rig);
+                                          read only by samplers that simulate a LiDAR
     <root>/intrinsics/<stem>.txt              optional, per frame, same format
+or <root>/train/ and <root>/val/, each laid out as <root> above: `lipjax train` trains on train/ and validates on
+val/ (without them, on all but the last 5 % of the frames and on that 5 %).
 
 Depth scales of common sensors (raw PNG value per metre): KITTI 256, NYU / Kinect / RealSense 1000,
 TUM RGB-D 5000. A PNG depth has no unit in it, so the scale must be given: there is no default.
@@ -35,10 +40,14 @@ DEPTH_SUFFIXES = (".png", ".npy")
 KNOWN_DEPTH_SCALES = {"kitti": 256.0, "nyu": 1000.0, "tum": 5000.0}
 OUT_FORMATS = ("npy", "png", "color.png")
 
-FOLDER_LAYOUT = """\
+SPARSE_DIR = "sparse"  # <root>/sparse/<stem>.png|.npy: a folder's own sparse input (optional)
+FOLDER_LAYOUT = f"""\
 <root>/rgb/<stem>.png|.jpg
 <root>/depth/<stem>.png (16-bit, needs depth_scale) or <stem>.npy (float metres)
-<root>/intrinsics.txt ("fx fy cx cy" or 9 numbers of K)  or  <root>/intrinsics/<stem>.txt"""
+<root>/{SPARSE_DIR}/<stem>.png|.npy (optional: your own sparse input, as depth/)
+<root>/intrinsics.txt ("fx fy cx cy" or 9 numbers of K) or <root>/intrinsics/<stem>.txt (optional: read only by a
+    sampler that simulates a LiDAR)
+or <root>/train/ and <root>/val/, each laid out as above"""
 FOLDER_SOURCE = "your own frames (lipjax.data.folder.FolderDataset)"
 
 _DIGITS = re.compile(r"(\d+)")

@@ -39,6 +39,10 @@ MIN_SPARSE_DEPTH_M = 1e-3
 
 
 class SparseSampler(Protocol):
+    """What every sampler is: called with a Sample (its depth (H, W) float32 metres and validity mask) and a seed,
+    it returns the sparse input, (H, W) float32 metres with 0 = no sample; the same (seed, sample.id) always gives
+    the same samples (`example_rng`)."""
+
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray: ...
 
 

@@ -198,13 +198,13 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
 
         return TartanAirDataset(root, split), None
     if source == "folder":
-        from lipjax.data.folder import FolderDataset
+        from lipjax.data.folder import SPARSE_DIR, FolderDataset
 
         folder, own_split = folder_split_root(Path(root), split)
         spec = data.train_sampler if split == "train" else data.val_sampler
         dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}",
                                 intrinsics_needed=uses_intrinsics(spec))
-        own = FolderInput(os.fspath(folder / "sparse"), data.depth_scale, dataset.id_prefix)
+        own = FolderInput(os.fspath(folder / SPARSE_DIR), data.depth_scale, dataset.id_prefix)
         if own_split:
             return dataset, own
         return Subset(dataset, tail_split(["all"] * len(dataset), split)), own

@@ -2,7 +2,8 @@
 `--set FIELD=VALUE` overrides of `python -m experiments.train` (parse_overrides, apply_overrides).
 
 A run has up to three phases, by global step:
-    [0, g_steps)                      G supervised pretraining (L2 through the whole unrolled solver)
+    [0, g_steps)                      G supervised pretraining (the depth loss `loss`, L2 by default, L1 in the
+                                      configs of the shipped models; through the whole unrolled solver)
     [g_steps, g_steps + d_steps)      D pretraining (cross-entropy, G frozen)
     [.., .. + adv_steps)              joint G + D adversarial training (LIP+AD)
 LIP+CNN is g_steps only; LIP+AD adds the other two (usually starting from a LIP+CNN model via `init_from`).
@@ -77,7 +78,7 @@ class TrainConfig:
     warmup_steps: int = 100
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
-    loss: str = "l2"
+    loss: str = "l2"  # "l2" or "l1" (lipjax.train.losses); the shipped models' configs (experiments/configs/) set "l1"
     loss_scale: str = "max_depth"  # depth errors in units of: the model's max depth, or "samples" (see __post_init__)
     inverse_depth_weight: float = 0.0  # weight of lipjax.train.losses.inverse_depth_loss (1/m) added to the depth loss
     inverse_depth_floor_m: float = 1.0

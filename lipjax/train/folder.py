@@ -47,13 +47,14 @@ def folder_config(model, init_from: str | None, *, name: str = "lip-cnn-folder",
 
 
 def default_init(**data) -> tuple[str, str, str]:
-    """The model `lipjax train` fine-tunes by default: the shipped default model (lipjax.inputs.DEFAULT_MODELS) of
+    """The model `lipjax train` fine-tunes by default: the shipped default model (lipjax.shipped.DEFAULT_MODELS) of
     the scene that the first training frame's input suggests (lipjax.inputs.scene_reason), as `lipjax complete`
     picks it. data: DataConfig fields over FOLDER_DATA, as folder_config takes them.
 
     Returns (model name, scene, the evidence in words)."""
     from lipjax.data.sources import open_source
-    from lipjax.inputs import DEFAULT_MODELS, scene_reason
+    from lipjax.inputs import scene_reason
+    from lipjax.shipped import DEFAULT_MODELS
 
     source = open_source(dataclasses.replace(FOLDER_DATA, **data), "train")
     scene, why = scene_reason(source.sampler(source.dataset[0], 0))
@@ -65,7 +66,7 @@ def check_frames(data: DataConfig) -> int:
     "input"), both splits, in threads. Returns the number of frames; raises one DatasetError naming every
     unreadable file (path relative to data.root and the reason), so that a bad file stops the run before
     training rather than at the step that first draws it."""
-    from lipjax.data.folder import FolderDataset, read_depth
+    from lipjax.data.folder import SPARSE_DIR, FolderDataset, read_depth
     from lipjax.data.sources import folder_split_root, uses_intrinsics
 
     root = Path(data.root).resolve()
@@ -76,7 +77,8 @@ def check_frames(data: DataConfig) -> int:
     for folder in sorted(folders):
         dataset = FolderDataset(folder, depth_scale=data.depth_scale, intrinsics_needed=needed)
         jobs += [functools.partial(dataset.__getitem__, i) for i in range(len(dataset))]
-        sparse = sorted((folder / "sparse").glob("*.*")) if own_input and (folder / "sparse").is_dir() else []
+        own = folder / SPARSE_DIR
+        sparse = sorted(own.glob("*.*")) if own_input and own.is_dir() else []
         jobs += [functools.partial(read_depth, p, data.depth_scale if p.suffix.lower() == ".png" else None)
                  for p in sparse if p.suffix.lower() in (".png", ".npy")]
 
