@@ -178,8 +178,9 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
-    estimate z (h, w) is resized back (bilinear). Then the final x-update runs at full size: with rho -> 0 at the
-    measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value.
+    estimate z (h, w) is resized back (bilinear). Then, at any size, the final x-update runs at full size: with
+    rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
+    measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
     With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why).
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
     bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
@@ -196,10 +197,11 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     run = functools.partial(mirror_averaged, completer) if mirror and isinstance(completer, Completer) else completer
     if (h, w) == (big_h, big_w):
-        return np.asarray(run(rgb, sparse_m), np.float32)
-    small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-    small = np.asarray(run(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
-    dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+        dense = np.array(run(rgb, sparse_m), np.float32)
+    else:
+        small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
+        small = np.asarray(run(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
+        dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
-    return dense.astype(np.float32)
+    return dense

@@ -199,8 +199,13 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
     for size in ((40, 56), (20, 28)):
         got = complete_at(completer, rgb, sparse, size, mirror=True)
         assert np.abs(got - complete_at(completer, rgb, sparse, size)).max() > 1e-3  # off by default
-    small = complete_at(completer, rgb, sparse, (20, 28), mirror=True)  # below full size measured pixels are set back
-    np.testing.assert_array_equal(small[sparse > 0], sparse[sparse > 0])
-    np.testing.assert_allclose(complete_at(completer, rgb, sparse, (40, 56), mirror=True), averaged, rtol=0, atol=1e-6)
+    for size in ((40, 56), (20, 28)):  # at any size the measured pixels are set back (the model's x keeps them ~)
+        for mirror in (False, True):
+            got = complete_at(completer, rgb, sparse, size, mirror=mirror)
+            np.testing.assert_array_equal(got[sparse > 0], sparse[sparse > 0])
+    assert np.abs(completer(rgb, sparse)[sparse > 0] - sparse[sparse > 0]).max() > 1e-3
+    unmeasured = sparse == 0
+    np.testing.assert_allclose(complete_at(completer, rgb, sparse, (40, 56), mirror=True)[unmeasured],
+                               averaged[unmeasured], rtol=0, atol=1e-6)
     np.testing.assert_allclose(lipjax.complete(rgb, sparse, model=completer, mirror=True),
                                inference.complete_frame(completer, rgb, sparse, mirror=True), rtol=0, atol=1e-6)
