@@ -62,7 +62,12 @@ class Completer:
         return self if config is self.config else Completer(config, params, self.name, self.metadata)
 
     def __call__(self, rgb: np.ndarray, sparse: np.ndarray) -> np.ndarray:
-        """Dense depth in metres, (H, W) or (B, H, W) like the input."""
+        """Dense depth in metres, (H, W) or (B, H, W) like the input: the model itself, at the input's size.
+
+        `lipjax.complete(rgb, sparse, model=completer)` is the default path instead (`complete_frame`): the model at
+        the working size of the samples (lipjax.resolution), every measured pixel set back. On 200 points on 480x640
+        synthetic rooms the two differ a lot: lip-any is 0.95x a linear fill at full size and 0.82x at the working
+        size (benchmarks/working_resolution.py, the README's "Any resolution")."""
         rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained,
                                              self.both_scenes)
         depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, self.config.host_inputs(sparse))
@@ -70,9 +75,10 @@ class Completer:
         return depth if batched else depth[0]
 
     def trajectory(self, rgb: np.ndarray, sparse: np.ndarray):
-        """(final depth, Trajectory) for a batch; each trajectory array is (K, B, H, W) metres."""
+        """(final depth, Trajectory) for a batch, as jax arrays: depth (B, H, W) metres, not clamped at 0 (the
+        solver's own output, as training sees it); each trajectory array is (K, B, H, W) metres."""
         rgb, sparse, _ = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained,
-                                             self.both_scenes)
+                                      self.both_scenes)
         return compiled_apply(self.config, True)(self.params, rgb, sparse, self.config.host_inputs(sparse))
 
     def parameter_count(self) -> int:
