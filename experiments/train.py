@@ -18,7 +18,7 @@ from lipjax.train.config import parse_overrides
 from lipjax.train.run import run
 from lipjax.utils import enable_compilation_cache
 
-PROG = f"python -m {__spec__.name}"  # as run: the same when imported
+PROG = "python -m experiments.train"  # how it is run (also right as a script: no __spec__)
 
 
 def main(argv=None) -> None:

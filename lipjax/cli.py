@@ -9,7 +9,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] [--scattered] --out FILE
+    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] [--scattered] [--mirror] --out F
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]  (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
@@ -40,13 +40,7 @@ from lipjax.utils import enable_compilation_cache, limit_cpu_threads
 
 PROG = "lipjax"
 _RAW = argparse.RawDescriptionHelpFormatter
-
-
-def _depth_scale(text: str) -> float:
-    try:
-        return parse_depth_scale(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+_depth_scale = console.argument_type(parse_depth_scale)  # --depth-scale: 256, 1000, kitti, nyu, ...
 
 
 def _cmd_complete(args) -> int:
@@ -88,8 +82,8 @@ def _cmd_evaluate(args) -> int:
 def _cmd_export(args) -> int:
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     try:
-        written = export(args.model, args.out, iterations=args.iterations, platforms=platforms,
-                         **{k: getattr(args, k) for k in ("height", "width", "batch", "samples", "scattered")})
+        written = export(args.model, args.out, iterations=args.iterations, platforms=platforms, **{
+            k: getattr(args, k) for k in ("height", "width", "batch", "samples", "scattered", "mirror")})
     except ImportError as exc:  # the optional flatbuffers / onnx packages
         raise console.UserError(str(exc)) from exc
     if not args.quiet:
@@ -160,7 +154,7 @@ def _add_complete_parser(sub) -> None:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
-    c.add_argument("--mirror", action="store_true", help="average with the mirror image's depth: better, 2x time")
+    c.add_argument("--mirror", action="store_true", help="learned models: average with the mirror image (2x time)")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
@@ -225,6 +219,7 @@ def _add_export_parser(sub) -> None:
     x.add_argument("--batch", type=console.positive_int, default=1)
     x.add_argument("--samples", type=console.positive_int, help=".onnx: samples per frame (sets the working size)")
     x.add_argument("--scattered", action="store_true", help=".onnx: scattered points, not LiDAR scan lines")
+    x.add_argument("--mirror", action="store_true", help=".onnx: as lipjax complete --mirror, in the graph")
     x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
     x.add_argument("--quiet", action="store_true")

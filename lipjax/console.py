@@ -12,10 +12,12 @@ line too, with exit status 2. LIPJAX_DEBUG=1 shows the Python traceback instead.
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import sys
 import warnings
 from collections.abc import Callable, Sequence
+from typing import Any
 
 # What a user's mistake raises: InputError, DatasetError, ModelFileError, CheckpointError are ValueErrors;
 # a missing or unreadable file is an OSError.
@@ -42,6 +44,20 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a positive integer, got {text}")
     return value
+
+
+def argument_type(parse: Callable[[str], Any]) -> Callable[[str], Any]:
+    """`parse` as an argparse type: its ValueError becomes the usage error's message (argparse would otherwise print
+    only "invalid <name> value")."""
+
+    @functools.wraps(parse)
+    def convert(text: str):
+        try:
+            return parse(text)
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+
+    return convert
 
 
 def positive_int_list(text: str) -> list[int]:

@@ -172,19 +172,20 @@ class ExportedFile:
 
 
 def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
-           platforms: Sequence[str] | None = None, samples: int | None = None,
-           scattered: bool = False) -> ExportedFile | OnnxFile:
+           platforms: Sequence[str] | None = None, samples: int | None = None, scattered: bool = False,
+           mirror: bool = False) -> ExportedFile | OnnxFile:
     """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
     (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`). `platforms`
     applies to .stablehlo, `samples` (per frame) and `scattered` (points, not LiDAR scan lines), which set the
-    working size, to .onnx.
+    working size, and `mirror` (lipjax.complete's mirror averaging in the graph), to .onnx.
 
     Raises ValueError for an unknown extension, an option of the other format or a hand-crafted fill (nothing
     learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the
     model loads."""
     onnx = export_format(out) == ".onnx"
+    given = {"--samples": samples, "--scattered": scattered or None, "--mirror": mirror or None}
     wrong = ("--platforms", platforms, ".stablehlo") if onnx else \
-        ("--samples" if samples is not None else "--scattered", samples or scattered or None, ".onnx")
+        next(((flag, value, ".onnx") for flag, value in given.items() if value is not None), (None, None, None))
     if wrong[1] is not None:
         raise ValueError(f"{wrong[0]} applies to {wrong[2]} exports only; drop it for {os.fspath(out)}")
     need_onnx() if onnx else _need_flatbuffers()
@@ -194,7 +195,7 @@ def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int
                          "shipped model (lipjax models) or a saved model path")
     if onnx:
         return export_onnx(completer, out, height=height, width=width, batch=batch, samples=samples,
-                           scan_lines=not scattered)
+                           scan_lines=not scattered, mirror=mirror)
     exported = export_completer(completer, batch, height, width, platforms=platforms)
     path = save_exported(exported, out)
     return ExportedFile(path, exported, completer.config.initial_estimate if len(exported.in_avals) == 3 else None)

@@ -99,9 +99,10 @@ in training, at most 60,000 pixels for LiDAR scan lines (sizes HxW: 200 points o
 64-beam KITTI scan at 132x455; dense scattered samples at full size); a
 new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
 pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
-averaged); the result is resized back (bilinear) and the measured pixels are then set to their measured values
-exactly.
-`--max-side N` overrides the working size: the longer side becomes at most N pixels.
+averaged); the result is resized back (bilinear). At any size the measured pixels are then set to their measured
+values exactly.
+`--max-side N` overrides the working size: the longer side becomes at most N pixels. `--mirror` (learned models)
+also runs the mirror image of each frame and averages the two: more accurate, twice the model's time.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.

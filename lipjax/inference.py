@@ -168,7 +168,8 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
                    mirror: bool = MIRROR_AVERAGE) -> np.ndarray:
-    """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`)."""
+    """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`);
+    `max_side` caps the longer side instead (pixels), `mirror` as in `complete_at`."""
     return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror)
 
 
@@ -201,7 +202,9 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     rgb, sparse_m = rgb[0], sparse[0]
     big_h, big_w = sparse_m.shape
     h, w = size
-    run = functools.partial(mirror_averaged, completer) if mirror and isinstance(completer, Completer) else completer
+    if mirror and not isinstance(completer, Completer):
+        raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
+    run = functools.partial(mirror_averaged, completer) if mirror else completer
     if (h, w) == (big_h, big_w):
         dense = np.array(run(rgb, sparse_m), np.float32)
     else:

@@ -34,7 +34,9 @@ than the one lipjax trains with, see that module):
      lipjax.complete on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm, 99th percentile
      at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
-     (cv2's INTER_LINEAR) and the measured pixels set back to their measured values.
+     (cv2's INTER_LINEAR) and the measured pixels set back to their measured values. With `mirror=True`
+     (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
+     estimates are averaged after flipping the second back, as `lipjax.complete(..., mirror=True)` does.
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. No input
 checks run inside the graph (check with `lipjax.inputs.check_inputs` where lipjax is installed); a frame without
 samples gives zeros.
@@ -144,13 +146,14 @@ def nearest_twin(completer: Completer) -> Completer:
 class OnnxFile:
     """What `export_onnx` wrote: the file, the input shape (B, H, W), the working size, the sample counts for which
     that is lipjax.complete's working size, and the model's own initial fill when the graph's nearest fill replaced
-    it (else None)."""
+    it (else None); whether the graph averages with the mirror image."""
 
     path: pathlib.Path
     shape: tuple[int, int, int]
     working: tuple[int, int]
     samples: tuple[int, int]
     replaced_fill: str | None
+    mirror: bool = False
 
     def summary(self) -> str:
         """The lines the export command prints: file and signature, the working size, the fill."""
@@ -162,6 +165,8 @@ class OnnxFile:
         if self.replaced_fill:
             lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
                          "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
+        if self.mirror:
+            lines.append("mirror averaging in the graph: equal to lipjax.complete(..., mirror=True)")
         return "\n".join(lines)
 
 
@@ -200,4 +205,4 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     onnx.save(model, os.fspath(path))
-    return OnnxFile(path, (batch, height, width), working, interval, replaced)
+    return OnnxFile(path, (batch, height, width), working, interval, replaced, mirror)

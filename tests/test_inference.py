@@ -209,3 +209,5 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
                                averaged[unmeasured], rtol=0, atol=1e-6)
     np.testing.assert_allclose(lipjax.complete(rgb, sparse, model=completer, mirror=True),
                                inference.complete_frame(completer, rgb, sparse, mirror=True), rtol=0, atol=1e-6)
+    with pytest.raises(lipjax.InputError, match="mirror averaging is for learned models; drop --mirror"):
+        lipjax.complete(rgb, sparse, model="linear", mirror=True)

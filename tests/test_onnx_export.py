@@ -92,11 +92,13 @@ def auto_model():
     return perturbed(c)
 
 
-def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path):
+@pytest.mark.parametrize("mirror", [False, True])
+def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path, mirror):
     """128x160 with 10 points runs at 64x80 (area resize, reprojection, bilinear back): scattered points, so
-    lipjax.complete fills linearly and the graph equals the model's nearest twin, not the model itself."""
+    lipjax.complete fills linearly and the graph equals the model's nearest twin, not the model itself; with and
+    without mirror averaging."""
     h, w = 128, 160
-    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10)
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, mirror=mirror)
     assert written.working == (64, 80) and written.replaced_fill == "auto"
     assert "instead of the model's 'auto'" in written.summary() and "64x80" in written.summary()
     rng = np.random.default_rng(3)
@@ -104,11 +106,11 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
     sparse = np.zeros((1, h, w), np.float32)
     sparse.reshape(-1)[rng.choice(h * w, 10, replace=False)] = rng.uniform(1, 8, 10)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    in_jax = np.asarray(jax.jit(inference_graph(auto_model, (h, w), (64, 80)))(rgb, sparse))
+    in_jax = np.asarray(jax.jit(inference_graph(auto_model, (h, w), (64, 80), mirror=mirror))(rgb, sparse))
     np.testing.assert_allclose(got, in_jax, rtol=1e-5, atol=1e-5)
-    expected = lipjax.complete(rgb[0], sparse[0], model=nearest_twin(auto_model))
+    expected = lipjax.complete(rgb[0], sparse[0], model=nearest_twin(auto_model), mirror=mirror)
     np.testing.assert_allclose(got[0], expected, rtol=1e-5, atol=1e-4)
-    linear = lipjax.complete(rgb[0], sparse[0], model=auto_model)
+    linear = lipjax.complete(rgb[0], sparse[0], model=auto_model, mirror=mirror)
     assert np.abs(got[0] - linear).max() > 0.01  # the Delaunay fill differs: that is the documented gap
     measured = sparse[0] > 0
     np.testing.assert_array_equal(got[0][measured], sparse[0][measured])
@@ -130,11 +132,11 @@ def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_mo
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
 
 
-@pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}])
+@pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}, {"mirror": True}])
 def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_path):
     from lipjax.export import export
 
-    name = "--samples" if "samples" in option else "--scattered"
+    name = "--" + next(iter(option))
     with pytest.raises(ValueError, match=f"^{name} applies to .onnx exports only; drop it"):
         export("linear", tmp_path / "m.stablehlo", height=8, width=8, **option)
 
@@ -157,3 +159,4 @@ def test_a_mirror_averaged_export_equals_complete_with_mirror(auto_model, tmp_pa
     import onnx
 
     assert {p.key: p.value for p in onnx.load(str(written.path)).metadata_props}["mirror_averaged"] == "true"
+    assert "mirror averaging in the graph" in written.summary() and "mirror averaging" not in plain.summary()
