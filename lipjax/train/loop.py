@@ -224,13 +224,13 @@ def train(
     process_count = jax.process_count() if process_count is None else process_count
     is_main = process_index == 0
 
+    val = validation_batches(config) if config.eval_every else []  # a missing data set fails before the model init
     manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
     state, meta = _resume(config, manager, is_main)
     start = int(state.step)
     rng = jax.random.wrap_key_data(np.asarray(state.rng))
     state = jax.device_put(state, NamedSharding(mesh, PartitionSpec()))  # replicated
     steps = make_steps(config)
-    val = validation_batches(config) if config.eval_every else []
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
     loader = _train_loader(config, start, meta, process_index, process_count)
     shown = _Progress(config, workdir, start, end, progress, is_main)
