@@ -119,8 +119,8 @@ def default_model(scene: str = "indoor") -> Completer:
 
 
 # Whether the default path (`complete_at`, `lipjax.complete`, `lipjax complete`, the ONNX graph) averages a learned
-# model's estimate with that of the mirror-image frame (`mirror_averaged`). Off: with the 228,000-image lip-any it is more
-# accurate (`benchmarks/generalisation.py --frames 8`: 0.7755 -> 0.7661 x linear, every setting better but far
+# model's estimate with that of the mirror-image frame (`mirror_averaged`). Off: with the 228,000-image lip-any it is
+# more accurate (`benchmarks/generalisation.py --frames 8`: 0.7755 -> 0.7661 x linear, every setting better but far
 # views, 0.958 -> 0.964) but takes twice the model's time (benchmarks/speed.py: 480x640 with 200 points 62 -> 117
 # ms, 17.7 -> 9.6 frames/s normalised; 352x1216 with 64 beams 75 -> 139 ms), below the 10 frames/s the default
 # path keeps. Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
