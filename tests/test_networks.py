@@ -77,7 +77,9 @@ def test_output_has_input_size_is_finite_and_survives_a_model_file(name, tmp_pat
     depth = np.asarray(_forward(config, params, rgb, sparse))
     assert depth.shape == SHAPE
     assert np.isfinite(depth).all()
-    assert np.abs(depth).max() > 0
+    assert np.abs(depth[0] - depth[1]).max() > 1e-6  # the output follows the input (two frames, two depths)
+    alone = np.asarray(_forward(config, params, rgb[1:], sparse[1:]))[0]  # no statistics shared across the batch
+    np.testing.assert_allclose(alone, depth[1], rtol=1e-4, atol=1e-5 * float(np.abs(depth).max()))
 
     model_io.save(tmp_path / name, config, params, {"note": "test"})
     loaded = lipjax.load_model(tmp_path / name)
