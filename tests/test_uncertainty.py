@@ -6,7 +6,7 @@ import pytest
 from scipy.stats import spearmanr
 
 from lipjax import uncertainty
-from lipjax.uncertainty import ABOVE_GAIN, SPREAD_GAIN, drop_uncertain, expected_error
+from lipjax.uncertainty import ABOVE_GAIN, SPREAD_GAIN, drop_uncertain, expected_error, support_features
 
 
 def _grid_frame():
@@ -94,8 +94,13 @@ def test_ranks_the_linear_fill_error_on_a_synthetic_val_frame():
     sparse = UniformSampler(100)(sample)
     dense = linear_fill(sparse)
     scored = sample.valid & (sparse == 0)
-    rho = spearmanr(expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored])[0]
-    assert rho > 0.3
+    u, error = expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored]
+    # it ranks the error better than the distance to the samples alone (the spread term carries information:
+    # measured 0.53 against 0.35 here), and, its gains fitted by least squares on these splits, it is calibrated
+    # to within a factor of 2 on average (measured 0.123 m expected against 0.093 m)
+    distance = support_features(sparse)["distance"][scored]
+    assert spearmanr(u, error)[0] > spearmanr(distance, error)[0] > 0
+    assert 0.5 < u.mean() / error.mean() < 2.0
 
 
 # ------------------------------------------------ `lipjax complete --uncertainty FILE --max-uncertainty M`
