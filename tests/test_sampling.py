@@ -362,6 +362,6 @@ def test_sensor_behind_the_camera_sees_a_wall_farther_and_its_returns_come_back_
     view = parallax.sensor_view(depth, depth > 0, K_BOX, behind)
     assert np.all(view == 4.5)
     back = parallax.to_camera(view, K_BOX, behind)
-    # the sensor's pixels, 4.5 m from it, land 4/4.5 as far apart on the camera's grid: they cover (4/4.5)^2 of it
+    # the sensor's pixels, 4.5 m from it, land 4.5/4 camera pixels apart: they cover (4/4.5)^2 of the camera's grid
     # (measured 0.779 against 0.790: pixels that round onto the same camera pixel)
     assert np.all(back[back > 0] == 4.0) and (back > 0).mean() == pytest.approx((4 / 4.5) ** 2, abs=0.02)
