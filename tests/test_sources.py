@@ -287,7 +287,9 @@ def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path, capsys):
     """The issue's "done when": the named config on NYU h5 files, exported to a given path, then `lipjax complete`
     and `lipjax evaluate --source nyu_h5` (the fixture frames are 30x40, so the nyu_paper crop is replaced by
     protocol none)."""
+    import lipjax
     from lipjax import cli
+    from lipjax.data.folder import read_frame
 
     root = make_nyu(tmp_path / "nyu")
     model = tmp_path / "model"
@@ -303,7 +305,9 @@ def test_lip_cnn_nyu_trains_exports_and_the_model_completes(tmp_path, capsys):
     np.save(tmp_path / "sparse.npy", np.where(np.arange(H * W).reshape(H, W) % 13 == 0, depth, 0))
     done = complete(model, tmp_path / "rgb.png", tmp_path / "sparse.npy", tmp_path / "out.npy")
     assert done.returncode == 0, done.stderr[-3000:]
-    assert np.load(tmp_path / "out.npy").shape == (H, W)
+    rgb_read, sparse_read = read_frame(tmp_path / "rgb.png", tmp_path / "sparse.npy", None)
+    expected = lipjax.complete(rgb_read, sparse_read, model=lipjax.load_model(model))  # the exported model's output
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-5, atol=1e-5)
     assert cli.main(["evaluate", "--source", "nyu_h5", "--root", str(root), "--protocol", "none",
                      "--model", str(model), "--limit", "2", "--quiet"]) == 0
     row = [line for line in capsys.readouterr().out.splitlines() if line.startswith(f"| {model} |")]
