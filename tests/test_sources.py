@@ -448,7 +448,7 @@ def test_a_stopped_render_takes_its_workers_with_it_and_the_same_command_finishe
     what an uninterrupted render writes."""
     from lipjax.data.rendered import RenderSpec, _render_shard
 
-    out, count = tmp_path / "r", 120
+    out, count = tmp_path / "r", 40  # 10 shards: seconds of rendering left when the first one lands
     args = ["data", "render", "--kind", "indoor", "--count", str(count), "--height", "256", "--width", "320",
             "--workers", "2", "--out", str(out), "--quiet"]
     with open(tmp_path / "err.txt", "w") as err:
