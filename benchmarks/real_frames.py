@@ -2,7 +2,7 @@
 
 Run by hand (never a test; the frames are research-use data read from ../shared/realdata, never copied):
 
-    python benchmarks/real_frames.py [--model NAME] [--realdata ../shared/realdata] [--json out.json]
+    python benchmarks/real_frames.py [--model NAME] [--realdata ../shared/realdata] [--json out.json] [--mirror]
                                      [--sweep] [--plot docs/results/real_frames_working_res.png]
 
 Frames at their native size: NYU v2 (3, 480x640), KITTI (3, 375x1242), Middlebury 2014 Motorcycle (1, 497x741),
@@ -13,7 +13,8 @@ pixels. The reference is `linear` (Delaunay piecewise-linear, nearest outside th
 
 Columns: the default path (`lipjax complete` without flags: `get_completer(None, sparse)` picks the model and
 `complete_frame` its working size), the same with a uniform grey image (the RGB guidance's worth: grey / RGB),
-ip_basic and colorization. `--model` scores one model through the same path instead of the default choice.
+ip_basic and colorization. `--model` scores one model through the same path instead of the default choice;
+`--mirror` runs the path with mirror averaging (`lipjax complete --mirror`) for the model and its grey run.
 `--sweep` also runs the model at several target sample spacings (lipjax.resolution, with its pixel cap) and at the
 native size ("full"), and plots the geometric-mean ratio against the working resolution.
 """
@@ -82,6 +83,7 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
     ap.add_argument("--json", default=None)
+    ap.add_argument("--mirror", action="store_true", help="the default path with mirror averaging (--mirror)")
     ap.add_argument("--sweep", action="store_true", help="also sweep the working resolution")
     ap.add_argument("--plot", default=None, help="with --sweep: write the ratio-vs-resolution picture here")
     ap.add_argument("--classical", default="ip_basic,colorization", help="comma-separated classical methods")
@@ -94,12 +96,13 @@ def main(argv=None) -> None:
         grey = np.full_like(sample.rgb, GREY)
         ref = rmse(linear(sample.rgb, sparse), sample, sparse)
         t0 = time.perf_counter()
-        pred = complete_frame(completer, sample.rgb, sparse)
+        pred = complete_frame(completer, sample.rgb, sparse, mirror=args.mirror)
         ms = 1e3 * (time.perf_counter() - t0)
         row = {"group": group, "frame": sample.id, "input": input_name, "size": list(sample.shape),
                "model": completer.name, "working_size": list(frame_size(completer, sparse)),
                "linear_rmse_m": ref, "default": rmse(pred, sample, sparse) / ref,
-               "grey": rmse(complete_frame(completer, grey, sparse), sample, sparse) / ref, "ms": ms}
+               "grey": rmse(complete_frame(completer, grey, sparse, mirror=args.mirror), sample, sparse) / ref,
+               "ms": ms}
         for method in classical:
             row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
         if args.sweep:
