@@ -183,11 +183,11 @@ def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int
     learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the
     model loads."""
     onnx = export_format(out) == ".onnx"
-    given = {"--samples": samples, "--scattered": scattered or None, "--mirror": mirror or None}
-    wrong = ("--platforms", platforms, ".stablehlo") if onnx else \
-        next(((flag, value, ".onnx") for flag, value in given.items() if value is not None), (None, None, None))
-    if wrong[1] is not None:
-        raise ValueError(f"{wrong[0]} applies to {wrong[2]} exports only; drop it for {os.fspath(out)}")
+    other_format, other_options = (".stablehlo", {"--platforms": platforms}) if onnx else \
+        (".onnx", {"--samples": samples, "--scattered": scattered or None, "--mirror": mirror or None})
+    for flag, value in other_options.items():
+        if value is not None:
+            raise ValueError(f"{flag} applies to {other_format} exports only; drop it for {os.fspath(out)}")
     need_onnx() if onnx else _need_flatbuffers()
     completer = get_completer(model, iterations)
     if not isinstance(completer, Completer):
