@@ -81,7 +81,13 @@ def test_kitti_dc_smoke(tmp_path, capsys, no_real_data):
 
 def test_table3_and_sample_rate_smoke(tmp_path):
     doc = table3.main(["--variant", "smoke", "--out", str(tmp_path / "t3")])
-    assert len(doc["blocks"]) == 2
+    assert set(doc["blocks"]) == {"outdoor (KITTI odometry stand-in), 200 points",
+                                  "indoor (TartanAir stand-in), 200 points"}
+    for rows in doc["blocks"].values():
+        row = rows["nearest"]
+        assert row["num_images"] == 1 and row["sampler"] == "uniform:200"
+        assert row["rmse_m"] >= row["mae_m"] > 0 and 0 <= row["delta1_pct"] <= 100
+    assert doc["blocks"]["indoor (TartanAir stand-in), 200 points"]["nearest"]["protocol"] == "synthetic_indoor"
     assert (tmp_path / "t3" / "table3_block0.png").exists() and (tmp_path / "t3" / "table3_block1.png").exists()
     table = sample_rate.main(["--variant", "smoke", "--out", str(tmp_path / "sr")])
     assert set(table["nearest"]) == {50, 200}
