@@ -71,7 +71,7 @@ def _cmd_evaluate(args) -> int:
         args.model, iterations=args.iterations, min_depth_m=args.min_depth_m, max_depth_m=args.max_depth_m,
         limit=args.limit, seed=args.seed, progress=not args.quiet, data=args.data, source=args.source,
         root=args.root, raw_root=args.raw_root, split=args.split, kind=args.kind, size=args.size,
-        sampler=args.sampler, protocol=args.protocol, depth_scale=args.depth_scale,
+        sampler=args.sampler, protocol=args.protocol, depth_scale=args.depth_scale, working_size=args.working_size,
         intrinsics=args.intrinsics or args.intrinsics_file)
     print(report.header() + "\n\n" + markdown_table(report.results, columns=columns))
     if args.json:
@@ -199,10 +199,14 @@ def _add_evaluate_parser(sub) -> None:
                    "sparse/, else uniform:200")
     e.add_argument("--protocol", choices=sorted(PROTOCOLS) + [NO_PROTOCOL], help="named crop/resize + depth range "
                    "applied to each frame; none: frames as they are (with --source, still the source's depth range)")
-    e.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="of PNG depth in FOLDER (or --source folder)")
+    e.add_argument("--depth-scale", type=_depth_scale, metavar="S",
+                   help="PNG depth value per metre in FOLDER (or --source folder)")
     _add_intrinsics_args(e)
+    e.add_argument("--working-size", action="store_true", help="score models as `lipjax complete` runs them: at "
+                   "the samples' working size, measured pixels set back (default: at the input's size, as the tables)")
     e.add_argument("--min-depth-m", type=float)
-    e.add_argument("--max-depth-m", type=float, help="default: the protocol's (10 indoor, 80 outdoor; FOLDER: none)")
+    e.add_argument("--max-depth-m", type=float,
+                   help="default: the protocol's (10 indoor, 80 outdoor); FOLDER: required unless --protocol")
     e.add_argument("--limit", type=console.positive_int, metavar="N", help="evaluate the first N frames only")
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", help=f"comma-separated metric names (default: {','.join(DEFAULT_COLUMNS)})")

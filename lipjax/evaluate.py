@@ -43,6 +43,7 @@ from lipjax.data.protocols import Protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import DEFAULT_SAMPLER
 from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol
+from lipjax.inference import AtWorkingSize
 from lipjax.methods import get_completer
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 
@@ -396,7 +397,7 @@ class Evaluation:
 
 def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | None = None,
                      min_depth_m: float | None = None, max_depth_m: float | None = None, limit: int | None = None,
-                     seed: int = 0, progress: bool = True, **data: Any) -> Evaluation:
+                     seed: int = 0, progress: bool = True, working_size: bool = False, **data: Any) -> Evaluation:
     """Opens the frames (`open_eval_data(**data)`) and `evaluate`s every model on them, in order.
 
     Args:
@@ -407,6 +408,9 @@ def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | N
       min_depth_m, max_depth_m: the evaluated ground-truth range (min, max] metres; by default the data's range
         protocol's (a folder without --protocol has none: then max_depth_m is required).
       limit, seed, progress: as `evaluate` takes them.
+      working_size: score each model as `lipjax.complete` runs it (`lipjax.inference.AtWorkingSize`): a learned
+        model at the working size of each frame's samples, measured pixels set back. Default: at the input's size,
+        as the paper's tables are measured.
     """
     frames = open_eval_data(**data)
     protocol = frames.range_from
@@ -421,8 +425,9 @@ def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | N
         completer = get_completer(model, iterations, sparse=first)
         label = (os.fspath(model) if isinstance(model, (str, os.PathLike))
                  else "untrained" if completer.name == "random" else completer.name)
-        results[label] = evaluate(completer, frames.dataset, frames.sampler, min_depth_m=min_depth,
-                                  max_depth_m=max_depth, limit=limit, progress=progress, seed=seed)
+        run = AtWorkingSize(completer) if working_size else completer
+        results[label] = evaluate(run, frames.dataset, frames.sampler, min_depth_m=min_depth, max_depth_m=max_depth,
+                                  limit=limit, progress=progress, seed=seed)
     return Evaluation(results, frames, min_depth, max_depth)
 
 

@@ -173,6 +173,22 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror)
 
 
+@dataclasses.dataclass(frozen=True)
+class AtWorkingSize:
+    """`completer` run one frame at a time as `lipjax.complete` runs it (`complete_frame`: a learned model at the
+    working size of the samples, every measured pixel set back), named as `completer`: for scoring the default path
+    (`lipjax evaluate --working-size`) rather than the model at the input's size."""
+
+    completer: Any
+
+    @property
+    def name(self) -> str:
+        return self.completer.name
+
+    def __call__(self, rgb: np.ndarray, sparse_m: np.ndarray) -> np.ndarray:
+        return complete_frame(self.completer, rgb, sparse_m)
+
+
 def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray) -> np.ndarray:
     """(z(I, y) + flip(z(flip(I), flip(y)))) / 2 for one frame, rgb (h, w, 3) and sparse (h, w) metres: the model's
     estimate averaged with its estimate of the mirror-image frame, flipped back (one batched call)."""

@@ -141,3 +141,27 @@ def test_evaluate_methods_scores_each_model_over_the_data_range(tmp_path):
     np.save(tmp_path / "depth" / "0.npy", np.ones((H, W), np.float32))
     with pytest.raises(ValueError, match="give the evaluated depth range: --max-depth-m M"):
         evaluate_methods(["nearest"], data=str(tmp_path), progress=False)
+
+
+def test_working_size_scores_the_default_path_not_the_model_at_the_input_size():
+    """`working_size=True` scores exactly what lipjax.complete returns: the model at the samples' working size (here
+    64x80 for a 160x200 frame with 20 points), upsampled, every measured pixel set back (zero error there)."""
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.synthetic import SyntheticDataset
+    from lipjax.evaluate import evaluate_methods
+    from lipjax.inference import Completer, complete_frame, frame_size
+    from lipjax.model import LIPConfig
+    from lipjax.priors.network import network_preset
+
+    model = Completer.random(LIPConfig(prior=network_preset("tiny"), num_iterations=1))
+    kwargs = dict(data="synthetic-indoor", size=(160, 200), sampler="uniform:20", limit=2, progress=False)
+    plain = evaluate_methods([model], **kwargs).results["untrained"]
+    default = evaluate_methods([model], working_size=True, **kwargs).results["untrained"]
+    sample = SyntheticDataset("indoor", "test", size=1, height=160, width=200)[0]
+    sparse = sampler_from_spec("uniform:20")(sample, 0)
+    assert frame_size(model, sparse) == (64, 80)
+    expected = compute_metrics(complete_frame(model, sample.rgb, sparse), sample.depth, sample.valid, sparse,
+                               max_depth_m=10.0)
+    assert default.per_image[0]["rmse_m"] == pytest.approx(expected["rmse_m"], rel=1e-6)
+    assert default.metrics["mae_sampled_m"] == 0.0
+    assert default.metrics["rmse_m"] != pytest.approx(plain.metrics["rmse_m"], rel=1e-3)
