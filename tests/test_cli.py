@@ -450,3 +450,15 @@ def test_export_command_writes_an_onnx_graph_with_the_fill_inside(model, tmp_pat
     np.testing.assert_allclose(got[0], lipjax.complete(rgb, sparse, model=model[1]), rtol=1e-5, atol=1e-4)
     rc = cli.main(["export", "--height", "8", "--width", "8", "--platforms", "cpu", "--out", str(out)])
     assert rc == 1 and "--platforms applies to .stablehlo exports only" in capsys.readouterr().err
+
+
+def test_evaluate_working_size_scores_what_complete_returns(model, tmp_path):
+    """--working-size: the model at the samples' working size (64x80 here), measured pixels set back exactly."""
+    scores = {}
+    for flags in ([], ["--working-size"]):
+        out = tmp_path / f"{len(flags)}.json"
+        assert cli.main(["evaluate", "--model", model[0], "--data", "synthetic-indoor", "--size", "160", "200",
+                         "--limit", "1", "--sampler", "uniform:20", "--quiet", "--json", str(out), *flags]) == 0
+        scores[tuple(flags)] = json.loads(out.read_text())[model[0]]["metrics"]
+    assert scores[("--working-size",)]["mae_sampled_m"] == 0.0 < scores[()]["mae_sampled_m"]
+    assert scores[("--working-size",)]["rmse_m"] != scores[()]["rmse_m"]
