@@ -70,12 +70,25 @@ def test_data_consistency_goes_to_zero_with_rho():
     assert errs[2] < 1e-3
 
 
-def test_per_pixel_rho_broadcasts_like_scalar():
+def test_per_image_rho_broadcasts_like_scalar():
     y, m, z, u = _problem(3, shape=(2, 3, 4))
     rho = np.array([0.1, 2.0], np.float32)[:, None, None]
     x = x_update(y, m, z, u, rho)
     for b in range(2):
         np.testing.assert_allclose(x[b], x_update(y[b], m[b], z[b], u[b], float(rho[b, 0, 0])), rtol=1e-6)
+
+
+def test_per_pixel_rho_is_the_minimiser_of_the_pixelwise_weighted_objective():
+    """With rho varying over the pixels, eq. 6 becomes 1/2 ||y - A x||^2 + 1/2 ||diag(rho)^(1/2) (x - z + u)||^2:
+    its normal equations (diag(m) + diag(rho)) x = m y + rho (z - u), solved densely, give the x-update."""
+    y, w, z, u = _problem(4, shape=(3, 4), weights=True)
+    rho = np.random.default_rng(5).uniform(0.05, 3.0, (3, 4)).astype(np.float32)
+    n = y.size
+    lhs = np.diag(w.ravel().astype(np.float64)) + np.diag(rho.ravel().astype(np.float64))
+    rhs = w.ravel() * y.ravel() + rho.ravel() * (z.ravel() - u.ravel())
+    expected = np.linalg.solve(lhs, rhs.astype(np.float64)).reshape(3, 4)
+    assert n == 12 and len(np.unique(rho)) == n
+    np.testing.assert_allclose(np.asarray(x_update(y, w, z, u, rho)), expected, rtol=1e-5)
 
 
 def test_dual_update():
