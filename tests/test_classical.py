@@ -187,3 +187,22 @@ def test_colorization_follows_image_edges():
 def test_nested_dissection_order_is_a_permutation():
     for h, w in [(1, 1), (3, 7), (17, 9), (64, 80)]:
         np.testing.assert_array_equal(np.sort(nested_dissection_order(h, w)), np.arange(h * w))
+
+
+# ---------------------------------------------------------------- LIP+Wavelet (the unrolled solver, fixed prox)
+
+def test_lip_wavelet_keeps_constants_scales_with_depth_and_is_the_box_fill_without_a_threshold():
+    """Soft-thresholding Haar details leaves a constant map constant; the threshold follows the median sampled depth,
+    so scaling every depth by c scales the output by c (box fill, thresholding and x-update are all homogeneous);
+    with tau = 0 the prox is the identity (perfect reconstruction), so the solver returns its start, the box fill."""
+    from lipjax.classical.lip_wavelet import LIPWavelet
+    from lipjax.fill import box_fill
+
+    sparse, rgb = _random_sparse(24, 32, 40), _gray(24, 32)
+    constant = np.where(sparse > 0, 3.0, 0.0).astype(np.float32)
+    np.testing.assert_allclose(LIPWavelet()(rgb, constant), 3.0, rtol=1e-6)
+    out = LIPWavelet()(rgb, sparse)
+    np.testing.assert_allclose(LIPWavelet()(rgb, 2.5 * sparse), 2.5 * out, rtol=1e-5, atol=1e-5)
+    start = np.asarray(box_fill(sparse[None], (sparse > 0)[None].astype(np.float32)))[0]
+    np.testing.assert_allclose(LIPWavelet(tau_per_m_depth=0.0)(rgb, sparse), start, rtol=1e-5, atol=1e-5)
+    assert np.abs(out - start).max() > 0.1  # the default threshold does act

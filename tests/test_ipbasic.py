@@ -309,9 +309,12 @@ def test_adaptive_radii_follow_density_and_layout():
     lines = np.zeros((64, 64), np.float32)
     lines[::12, :] = 5.0  # scan lines 12 rows apart, dense along each line
     assert auto_radii_px(dense) == (1, 1)
-    ry, rx = auto_radii_px(sparse)
-    assert ry == rx and ry >= 6
-    ry, rx = auto_radii_px(lines)
-    assert rx == 1 and ry >= 4  # anisotropic: tall, thin kernels for LiDAR lines
+    # Closed forms (the RADIUS_PERCENTILE = 75th percentile of |dy| and |dx| to the nearest sample over the samples'
+    # box, numpy's linear rule): on a grid the nearest sample lies on the nearest row and column. Rows 0-48 of the
+    # ::16 grid lie 0 (4 rows), 1-7 (6 rows each) and 8 (3 rows) from a sample row: sorted, entry 36 of 49 is 6.
+    assert auto_radii_px(sparse) == (6, 6)
+    # Rows 0-60 of ::12 lines lie 0 (6), 1-5 (10 each), 6 (5) from a line: entry 45 of 61 is 4; every column holds
+    # samples, so |dx| = 0, raised to MIN_RADIUS_PX = 1. Anisotropic: tall, thin kernels for LiDAR lines.
+    assert auto_radii_px(lines) == (4, 1)
     np.testing.assert_array_equal(diamond_kernel(2), DIAMOND_5)
     np.testing.assert_array_equal(diamond_kernel(2, 1), [[0, 1, 0], [0, 1, 0], [1, 1, 1], [0, 1, 0], [0, 1, 0]])
