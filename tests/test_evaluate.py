@@ -135,6 +135,14 @@ def test_evaluate_methods_scores_each_model_over_the_data_range(tmp_path):
     assert list(report.results) == ["nearest", "linear"] and report.max_depth_m == 10.0
     assert all(r.num_images == 2 and r.max_depth_m == 10.0 for r in report.results.values())
     assert report.header() == "data: synthetic-indoor (2 frames), sampler: uniform:30, depth range: (0, 10] m"
+    from lipjax.classical import LinearFill
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.synthetic import SyntheticDataset
+
+    frames = SyntheticDataset("indoor", "test", height=16, width=24)  # the frames and inputs it names, scored alone
+    alone = evaluate(LinearFill(), frames, sampler_from_spec("uniform:30"), min_depth_m=0.0, max_depth_m=10.0,
+                     limit=2, progress=False)
+    assert report.results["linear"].metrics == alone.metrics and alone.metrics["rmse_m"] > 0
     for sub in ("rgb", "depth"):  # a folder of the user's frames has no depth range of its own
         (tmp_path / sub).mkdir()
     cv2.imwrite(str(tmp_path / "rgb" / "0.png"), np.zeros((H, W, 3), np.uint8))

@@ -31,6 +31,16 @@ def test_nyu_200pts_smoke_writes_results_table_and_figure(tmp_path, capsys, no_r
     assert doc["methods"]["nearest"]["rmse_m"] == metrics["nearest"]["rmse_m"] > 0
     # nearest-neighbour fill copies the samples: zero error on the sampled pixels
     assert doc["methods"]["nearest"]["mae_sampled_m"] == 0.0
+    from lipjax.classical import NearestFill
+    from lipjax.data.protocols import get_protocol
+    from lipjax.data.sampling import sampler_from_spec
+    from lipjax.data.synthetic import SyntheticDataset
+    from lipjax.evaluate import evaluate
+
+    protocol = get_protocol("synthetic_indoor")  # the rows are those of the frames and inputs the meta names
+    alone = evaluate(NearestFill(), SyntheticDataset("indoor", "test"), sampler_from_spec("uniform:200"),
+                     min_depth_m=protocol.min_depth_m, max_depth_m=protocol.max_depth_m, limit=2, progress=False)
+    assert doc["methods"]["nearest"]["rmse_m"] == pytest.approx(alone.metrics["rmse_m"], rel=1e-12)
     assert "| nearest |" in (tmp_path / "table.md").read_text()
     assert (tmp_path / "figure.png").stat().st_size > 1000
 
