@@ -355,7 +355,16 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
                     "--depth-scale", "1000")
     assert done.returncode == 0, done.stderr[-3000:]
-    assert np.load(tmp_path / "out.npy").shape == (H, W)
+    import lipjax
+    from lipjax.data.folder import read_depth, read_rgb
+
+    trained, start = lipjax.load_model(model), lipjax.load_model("lip-cnn-indoor")
+    assert trained.config == start.config
+    assert any(not np.array_equal(np.asarray(a), np.asarray(b)) for a, b in  # two steps did move the weights
+               zip(jax.tree_util.tree_leaves(trained.params), jax.tree_util.tree_leaves(start.params), strict=True))
+    rgb, sparse = read_rgb(root / "rgb" / "0000.png"), read_depth(root / "sparse" / "0000.png", 1000)
+    np.testing.assert_allclose(np.load(tmp_path / "out.npy"), lipjax.complete(rgb, sparse, model=trained),
+                               rtol=1e-5, atol=1e-5)  # the command's output is the exported model's completion
 
 
 def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_and_validates_at_0_and_the_end(
