@@ -85,22 +85,25 @@ def test_bad_shapes_and_empty_samples_are_errors():
         expected_error(np.zeros_like(sparse), depth)
 
 
-def test_ranks_the_linear_fill_error_on_a_synthetic_val_frame():
+def test_ranks_the_linear_fill_error_on_synthetic_test_frames():
     from lipjax.classical.interpolate import linear_fill
     from lipjax.data.sampling import UniformSampler
     from lipjax.data.synthetic import SyntheticDataset
 
-    sample = SyntheticDataset("indoor", "val", height=96, width=128)[0]
-    sparse = UniformSampler(100)(sample)
-    dense = linear_fill(sparse)
-    scored = sample.valid & (sparse == 0)
-    u, error = expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored]
-    # it ranks the error better than the distance to the samples alone (the spread term carries information:
-    # measured 0.53 against 0.35 here), and, its gains fitted by least squares on these splits, it is calibrated
-    # to within a factor of 2 on average (measured 0.123 m expected against 0.093 m)
-    distance = support_features(sparse)["distance"][scored]
-    assert spearmanr(u, error)[0] > spearmanr(distance, error)[0] > 0
-    assert 0.5 < u.mean() / error.mean() < 2.0
+    ratios = []
+    for sample in SyntheticDataset("indoor", "test", size=4, height=96, width=128):  # not the frames it was fitted on
+        sparse = UniformSampler(100)(sample)
+        dense = linear_fill(sparse)
+        scored = sample.valid & (sparse == 0)
+        u, error = expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored]
+        # it ranks the error better than the distance to the samples alone (the spread term carries information:
+        # measured 0.23-0.50 against 0.21-0.36 on these frames)
+        distance = support_features(sparse)["distance"][scored]
+        assert spearmanr(u, error)[0] > spearmanr(distance, error)[0] > 0
+        ratios.append(u.mean() / error.mean())
+    # its gains were fitted by least squares on val frames; on test frames it is calibrated to within a factor of 2
+    # (measured 0.66-1.19)
+    assert all(0.5 < r < 2.0 for r in ratios), ratios
 
 
 # ------------------------------------------------ `lipjax complete --uncertainty FILE --max-uncertainty M`
