@@ -49,9 +49,24 @@ def test_colorize_sparse_enlarges_points_nearest_on_top():
     np.testing.assert_array_equal(img[0, 0], 0)
 
 
-def test_comparison_grid_reads_on_a_laptop_screen(tmp_path):
+def test_comparison_grid_reads_on_a_laptop_screen(tmp_path, monkeypatch):
     """3 frames x 4 methods (each with its error map) fit a 1400 x 900 screen at 100 %; the error panels are the
-    error maps of their predictions; frames with other methods are an error."""
+    error maps of their predictions, labelled with their RMSE; frames with other methods are an error."""
+    from matplotlib.axes import Axes
+
+    shown, texts = [], []
+    imshow, text = Axes.imshow, Axes.text
+
+    def recorded_imshow(ax, image, **kwargs):
+        shown.append(np.asarray(image))
+        return imshow(ax, image, **kwargs)
+
+    def recorded_text(ax, x, y, s, **kwargs):
+        texts.append(s)
+        return text(ax, x, y, s, **kwargs)
+
+    monkeypatch.setattr(Axes, "imshow", recorded_imshow)
+    monkeypatch.setattr(Axes, "text", recorded_text)
     rng = np.random.default_rng(0)
     frames = []
     for i in range(3):
@@ -63,6 +78,16 @@ def test_comparison_grid_reads_on_a_laptop_screen(tmp_path):
     viz.save_comparison_grid(tmp_path / "fig.png", frames, max_m=10, max_error_m=0.5)
     height, width = cv2.imread(str(tmp_path / "fig.png")).shape[:2]
     assert 700 < width <= 1400 and 600 < height <= 900, (width, height)
+    # per frame: RGB, sparse, ground truth and the 4 predictions, then the 4 error maps; prediction = gt + offset,
+    # so each RMSE is its offset
+    assert len(shown) == 3 * (3 + 4 + 4)
+    for f, frame in enumerate(frames):
+        panels = shown[11 * f:11 * (f + 1)]
+        np.testing.assert_array_equal(panels[0], frame.rgb)
+        for pred, panel in zip(frame.predictions.values(), panels[7:], strict=True):
+            np.testing.assert_array_equal(panel, viz.error_map(pred, frame.gt_m, np.ones_like(frame.gt_m, bool), 0.5))
+    assert [t for t in texts if t.startswith("RMSE")] == ["RMSE 0.000 m", "RMSE 0.100 m", "RMSE 0.200 m",
+                                                          "RMSE 0.400 m"] * 3
     frames[1] = dataclasses.replace(frames[1], predictions={"A": frames[1].gt_m})
     with pytest.raises(ValueError, match="has methods \\['A'\\], not \\['A', 'B', 'C', 'linear'\\]"):
         viz.save_comparison_grid(tmp_path / "bad.png", frames, max_m=10, max_error_m=0.5)
