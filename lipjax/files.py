@@ -40,14 +40,14 @@ import numpy as np
 
 from lipjax import inference
 from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, output_format, pair_frames, read_frame,
-                                read_intrinsics, write_depth)
-from lipjax.data.lidar import read_lidar_frame
+                                read_intrinsics, read_rgb, write_depth)
+from lipjax.data.lidar import project_sweep, read_lidar_frame
 from lipjax.data.sample import Intrinsics
 from lipjax.inference import MIRROR_AVERAGE, Completer, complete_frame, frame_size
 from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
-from lipjax.pointcloud import IntrinsicsLike, backproject_rgbd, write_ply
+from lipjax.pointcloud import IntrinsicsLike, ProjectionCounts, backproject_rgbd, write_ply
 from lipjax.uncertainty import drop_uncertain, expected_error, support_mask, write_uncertainty
 from lipjax.viz import fitting_range
 
@@ -408,17 +408,20 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
 
 @dataclasses.dataclass(frozen=True)
 class Projected:
-    """What `project_file` wrote: the file, and the (H, W) float32 sparse depth in it, metres, 0 = no point."""
+    """What `project_file` wrote: the file, the (H, W) float32 sparse depth in it (metres, 0 = no point), and where
+    every point of the sweep went."""
 
     path: Path
     sparse: np.ndarray
+    counts: ProjectionCounts
 
     def summary(self) -> str:
-        """The line `lipjax project` prints: the file, how many pixels have depth, and their range (metres)."""
+        """The line `lipjax project` prints: the file, how many pixels have depth, their range (metres), and the
+        sweep's points kept and dropped."""
         sparse, (h, w) = self.sparse, self.sparse.shape
         n = int((sparse > 0).sum())
         return (f"wrote {self.path}: depth at {n} pixels ({100 * n / sparse.size:.1f} % of {w}x{h}), "
-                f"{sparse[sparse > 0].min():.2f} to {sparse.max():.2f} m")
+                f"{sparse[sparse > 0].min():.2f} to {sparse.max():.2f} m; {self.counts.summary()}")
 
 
 def project_file(rgb: str | os.PathLike, lidar: str | os.PathLike, calib: str | os.PathLike,
@@ -427,6 +430,6 @@ def project_file(rgb: str | os.PathLike, lidar: str | os.PathLike, calib: str | 
     depth to `out` (.npy metres, .png 16-bit at depth_scale or 256 per metre, .color.png a picture from 0 to its
     farthest point)."""
     fmt = output_format(out)
-    _, sparse, _ = read_lidar_frame(rgb, lidar, calib, camera)
+    sparse, _, counts = project_sweep(lidar, calib, read_rgb(rgb).shape[:2], camera, return_counts=True)
     write_depth(out, sparse, fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
-    return Projected(Path(out), sparse)
+    return Projected(Path(out), sparse, counts)

@@ -12,6 +12,7 @@ axis (not the range along the ray), as in KITTI, NYU and TUM depth images.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import pathlib
 
@@ -113,8 +114,33 @@ def write_ply(path: str | os.PathLike, points: np.ndarray, colors: np.ndarray | 
             np.savetxt(f, np.column_stack([points] + ([colors] if colors is not None else [])), fmt=fmt)
 
 
+@dataclasses.dataclass(frozen=True)
+class ProjectionCounts:
+    """Where every point of a sweep went when projected into a camera (`project_lidar_to_depth(...,
+    return_counts=True)`): points = not_finite + behind + outside + hidden + kept.
+
+    behind: camera z below min_depth_m (behind the camera or on it); outside: in front but off the image; hidden:
+    landed on a pixel where a nearer point landed too (the z-buffer kept that one); kept: one per pixel with depth.
+    """
+
+    points: int
+    not_finite: int
+    behind: int
+    outside: int
+    hidden: int
+    kept: int
+
+    def summary(self) -> str:
+        """One line: e.g. '19456 of 120340 points kept: 3100 hidden behind a nearer point on the same pixel, 80000
+        outside the image, 17784 behind the camera'."""
+        parts = [f"{self.hidden} hidden behind a nearer point on the same pixel", f"{self.outside} outside the image",
+                 f"{self.behind} behind the camera"] + ([f"{self.not_finite} not finite"] if self.not_finite else [])
+        return f"{self.kept} of {self.points} points kept: {', '.join(parts)}"
+
+
 def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike, T_cam_from_lidar: np.ndarray,
-                           image_size: tuple[int, int], min_depth_m: float = 1e-3) -> np.ndarray:
+                           image_size: tuple[int, int], min_depth_m: float = 1e-3, *, return_counts: bool = False
+                           ) -> np.ndarray | tuple[np.ndarray, ProjectionCounts]:
     """Projects a LiDAR point cloud into a camera: the sparse depth image the model takes as input.
 
     Args:
@@ -130,7 +156,7 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
       (H, W) float32 depth in metres (z in the camera frame), 0 where no point lands. A point lands in the pixel
       whose centre is nearest its projection; when several land in one pixel the nearest (smallest z) is kept,
       as a z-buffer would (a far point seen "through" a near surface is an occluded return). Points outside the
-      image are dropped.
+      image are dropped. With `return_counts`, also the ProjectionCounts of where every point went.
     """
     points = np.asarray(points_lidar, dtype=np.float64)
     if points.ndim != 2 or points.shape[1] < 3:
@@ -143,15 +169,22 @@ def project_lidar_to_depth(points_lidar: np.ndarray, intrinsics: IntrinsicsLike,
     h, w = (int(s) for s in image_size)
     k = as_intrinsics(intrinsics)
     cam = points[:, :3] @ t[:3, :3].T + t[:3, 3]
+    finite = np.isfinite(cam).all(axis=1)
     z = cam[:, 2]
-    keep = np.isfinite(cam).all(axis=1) & (z >= min_depth_m)
+    keep = finite & (z >= min_depth_m)
     cam, z = cam[keep], z[keep]
     col = np.floor(k.fx * cam[:, 0] / z + k.cx + 0.5)
     row = np.floor(k.fy * cam[:, 1] / z + k.cy + 0.5)
     inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     pixel = row[inside].astype(np.int64) * w + col[inside].astype(np.int64)
     z = z[inside]
-    return splat_nearest(pixel, z, (h, w))
+    sparse = splat_nearest(pixel, z, (h, w))
+    if not return_counts:
+        return sparse
+    kept = int(np.unique(pixel).size)
+    counts = ProjectionCounts(points=len(points), not_finite=int((~finite).sum()), behind=int((finite & ~keep).sum()),
+                              outside=int((~inside).sum()), hidden=int(inside.sum()) - kept, kept=kept)
+    return sparse, counts
 
 
 POINT_CLOUD_FORMATS = ".bin (KITTI: float32 x y z reflectance), .npy ((N, >=3) x y z ...) or .pcd (ascii / binary)"

@@ -192,7 +192,9 @@ def test_calibration_mistakes_are_named(tmp_path):
     with pytest.raises(DatasetError, match="no P5"):
         read_kitti_object_calib(write_object_calib(tmp_path / "calib.txt"), camera=5)
     np.save(tmp_path / "behind.npy", np.array([[-5.0, 0, 0]]))
-    with pytest.raises(ValueError, match="none of its 1 points lands in the 120x40 image"):
+    with pytest.raises(ValueError, match="none of its 1 points lands in the 120x40 image .*0 of 1 points kept: 0 "
+                                         "hidden behind a nearer point on the same pixel, 0 outside the image, 1 behind "
+                                         "the camera"):  # the counts say why: the transform's direction, likely
         project_sweep(tmp_path / "behind.npy", tmp_path / "calib.txt", (H, W))
 
 
@@ -228,12 +230,15 @@ def test_project_command_writes_the_sparse_image(tmp_path, capsys):
     args = ["project", "--lidar", str(tmp_path / "000000.bin"), "--calib", str(calib), "--rgb",
             str(tmp_path / "image.png")]
     assert cli.main(args + ["--out", str(tmp_path / "sparse.npy")]) == 0
-    expected, _ = project_sweep(tmp_path / "000000.bin", calib, (H, W))
+    expected, _, counts = project_sweep(tmp_path / "000000.bin", calib, (H, W), return_counts=True)
     np.testing.assert_array_equal(np.load(tmp_path / "sparse.npy"), expected)
     n = int((expected > 0).sum())
     line = capsys.readouterr().err.strip()
     assert line == (f"wrote {tmp_path / 'sparse.npy'}: depth at {n} pixels ({100 * n / (H * W):.1f} % of {W}x{H}), "
-                    f"{expected[expected > 0].min():.2f} to {expected.max():.2f} m")
+                    f"{expected[expected > 0].min():.2f} to {expected.max():.2f} m; {counts.summary()}")
+    # every point of the sweep accounted for: all 300 lie 5-30 m in front of camera 2, so none is behind it
+    assert counts.points == 300 and counts.behind == counts.not_finite == 0 and counts.kept == n
+    assert counts.kept + counts.hidden + counts.outside == 300 and counts.outside > 0
     assert cli.main(args + ["--out", str(tmp_path / "sparse.png"), "-q"]) == 0
     raw = cv2.imread(str(tmp_path / "sparse.png"), cv2.IMREAD_UNCHANGED)
     assert raw.dtype == np.uint16 and capsys.readouterr().err == ""

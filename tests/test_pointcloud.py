@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from lipjax.data.sample import Intrinsics
-from lipjax.pointcloud import backproject, backproject_rgbd, project_lidar_to_depth, write_ply
+from lipjax.pointcloud import ProjectionCounts, backproject, backproject_rgbd, project_lidar_to_depth, write_ply
 
 H, W = 24, 32
 K = Intrinsics(fx=30.0, fy=28.0, cx=15.5, cy=11.0)
@@ -91,6 +91,23 @@ def test_points_behind_the_camera_or_outside_the_image_are_dropped():
     depth = project_lidar_to_depth(np.column_stack([points, np.ones(len(points))]), K, np.eye(4), (H, W))
     assert depth.shape == (H, W) and depth.dtype == np.float32
     assert np.count_nonzero(depth) == 1 and depth[5, 3] == pytest.approx(4.0)
+
+
+def test_counts_say_where_every_point_went():
+    """points = not_finite + behind + outside + hidden + kept, each counted on a sweep built to hold a known number."""
+    ray = np.array([(7 - K.cx) / K.fx, (4 - K.cy) / K.fy, 1.0])  # through the centre of pixel (row 4, col 7)
+    points = np.array([
+        [np.nan, 0.0, 2.0],                              # not finite
+        [0.0, 0.0, -2.0], [0.0, 0.0, 0.0],               # behind, and on the camera centre
+        [(W + 3 - K.cx) / K.fx * 2, 0.0, 2.0],           # right of the image
+        ray * 5.0, ray * 2.0, ray * 3.5,                 # one pixel: the nearest kept, two hidden
+        [(3 - K.cx) / K.fx * 4, (5 - K.cy) / K.fy * 4, 4.0],  # pixel (5, 3)
+    ])
+    depth, counts = project_lidar_to_depth(points, K, np.eye(4), (H, W), return_counts=True)
+    assert counts == ProjectionCounts(points=8, not_finite=1, behind=2, outside=1, hidden=2, kept=2)
+    assert counts.kept == np.count_nonzero(depth) and depth[4, 7] == pytest.approx(2.0)
+    assert counts.summary() == ("2 of 8 points kept: 2 hidden behind a nearer point on the same pixel, 1 outside the "
+                                "image, 2 behind the camera, 1 not finite")
 
 
 def test_bad_extrinsics_rejected():

@@ -19,18 +19,19 @@ from lipjax.pointcloud import project_lidar_to_depth, read_point_cloud
 
 
 def project_sweep(lidar_path: str | os.PathLike, calib_path: str | os.PathLike, image_size: tuple[int, int],
-                  camera: int = 2) -> tuple[np.ndarray, Intrinsics]:
+                  camera: int = 2, *, return_counts: bool = False):
     """((H, W) float32 sparse depth in metres, 0 = no point; the camera's intrinsics, pixels): the sweep projected
-    into KITTI camera `camera` (a rig file's one camera), keeping the nearest point per pixel. ValueError when
-    no point lands in the image (the wrong calibration or camera, most likely)."""
+    into KITTI camera `camera` (a rig file's one camera), keeping the nearest point per pixel; with `return_counts`
+    also where every point went (lipjax.pointcloud.ProjectionCounts). ValueError when no point lands in the image
+    (the wrong calibration or camera, most likely), with those counts."""
     intrinsics, cam_from_lidar = read_calibration(calib_path, camera)
     points = read_point_cloud(lidar_path)
-    sparse = project_lidar_to_depth(points, intrinsics, cam_from_lidar, image_size)
-    if not (sparse > 0).any():
+    sparse, counts = project_lidar_to_depth(points, intrinsics, cam_from_lidar, image_size, return_counts=True)
+    if not counts.kept:
         raise ValueError(f"{lidar_path}: none of its {len(points)} points lands in the {image_size[1]}x"
-                         f"{image_size[0]} image with the calibration {calib_path}; is it this sweep's calibration "
-                         "(and camera)?")
-    return sparse, intrinsics
+                         f"{image_size[0]} image with the calibration {calib_path} ({counts.summary()}); is it this "
+                         "sweep's calibration (and camera)?")
+    return (sparse, intrinsics, counts) if return_counts else (sparse, intrinsics)
 
 
 def read_lidar_frame(rgb_path: str | os.PathLike, lidar_path: str | os.PathLike, calib_path: str | os.PathLike,
