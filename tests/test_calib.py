@@ -192,9 +192,10 @@ def test_calibration_mistakes_are_named(tmp_path):
     with pytest.raises(DatasetError, match="no P5"):
         read_kitti_object_calib(write_object_calib(tmp_path / "calib.txt"), camera=5)
     np.save(tmp_path / "behind.npy", np.array([[-5.0, 0, 0]]))
+    # the counts say why (all behind the camera: the transform's direction, likely)
     with pytest.raises(ValueError, match="none of its 1 points lands in the 120x40 image .*0 of 1 points kept: 0 "
-                                         "hidden behind a nearer point on the same pixel, 0 outside the image, 1 behind "
-                                         "the camera"):  # the counts say why: the transform's direction, likely
+                                         "hidden behind a nearer point on the same pixel, 0 outside the image, 1 "
+                                         "behind the camera"):
         project_sweep(tmp_path / "behind.npy", tmp_path / "calib.txt", (H, W))
 
 
