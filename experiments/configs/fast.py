@@ -82,14 +82,14 @@ EXPECTED: dict[str, Expected] = {
     "lip_any": Expected(
         val_rmse_m=2.427944, images_seen=476_000, budget_from_config=False,
         note="thirteen runs: 4,000 steps from the 100,000-image lip-fast-indoor at learning rate 2e-4 with z0 the "
-             "linear fill, zoom 0.6-1.6 and texture probability 0.3 / strength 0.4, no camera noise (132,000 images; val "
-             "2.6348 m with z0 auto); then 4,000 steps of this config without relight, keypoints and holes from "
-             "that model (164,000; val 2.5845 m); then 2,000 such steps (180,000; val 2.5571 m); then 4,000 such "
-             "steps (212,000; val 2.5167 m, the mean of its last 4 checkpoints); then this config with --set "
-             "g_steps=2000 from that one (228,000; val 2.4962 m, its last checkpoint), all five with texture on one "
-             "rectangle, the reference camera and closed rooms; then eight cosine cycles of this config as it is now, "
-             "each from the previous one's export (--set g_steps=7000, 4500, 4500, 3000, 3000, 3000, 3000, 3000 and "
-             "--set init_from=<that export>: 284,000, 320,000, 356,000, 380,000, 404,000, 428,000, 452,000, 476,000 "
-             "images), the last exported as the mean of its last 4 checkpoints and shipped by the rule of "
-             "docs/training.md (its runs 14-21)"),
+             "linear fill, zoom 0.6-1.6 and texture probability 0.3 / strength 0.4, no camera noise (132,000 images; "
+             "val 2.6348 m with z0 auto); then 4,000 steps of this config without relight, keypoints and holes from "
+             "that model (164,000; val 2.5845 m); then 2,000 such steps (180,000; val 2.5571 m); then 4,000 such steps"
+             " (212,000; val 2.5167 m, the mean of its last 4 checkpoints); then this config with --set g_steps=2000 "
+             "from that one (228,000; val 2.4962 m, its last checkpoint), all five with texture on one rectangle, the "
+             "reference camera and closed rooms; then eight cosine cycles of this config as it is now, each from the "
+             "previous one's export (--set g_steps=7000, 4500, 4500, 3000, 3000, 3000, 3000, 3000 and --set "
+             "init_from=<that export>: 284,000, 320,000, 356,000, 380,000, 404,000, 428,000, 452,000, 476,000 images),"
+             " the last exported as the mean of its last 4 checkpoints and shipped by the rule of docs/training.md "
+             "(its runs 14-21)"),
 }
