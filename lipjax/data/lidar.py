@@ -15,11 +15,12 @@ import numpy as np
 from lipjax.data.calib import read_calibration
 from lipjax.data.folder import read_rgb
 from lipjax.data.sample import Intrinsics
-from lipjax.pointcloud import project_lidar_to_depth, read_point_cloud
+from lipjax.pointcloud import ProjectionCounts, project_lidar_to_depth, read_point_cloud
 
 
 def project_sweep(lidar_path: str | os.PathLike, calib_path: str | os.PathLike, image_size: tuple[int, int],
-                  camera: int = 2, *, return_counts: bool = False):
+                  camera: int = 2, *, return_counts: bool = False
+                  ) -> tuple[np.ndarray, Intrinsics] | tuple[np.ndarray, Intrinsics, ProjectionCounts]:
     """((H, W) float32 sparse depth in metres, 0 = no point; the camera's intrinsics, pixels): the sweep projected
     into KITTI camera `camera` (a rig file's one camera), keeping the nearest point per pixel; with `return_counts`
     also where every point went (lipjax.pointcloud.ProjectionCounts). ValueError when no point lands in the image
