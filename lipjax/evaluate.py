@@ -81,6 +81,8 @@ class EvalResult:
       ms_per_frame_median: median of the same.
       num_images: frames evaluated.
       min_depth_m, max_depth_m: the evaluated ground-truth depth range, metres.
+      size: where the completer ran: "input" (the frame's size, as the tables) or "working" (lipjax.complete's
+        default path, `lipjax.inference.AtWorkingSize`).
     """
 
     name: str
@@ -92,6 +94,7 @@ class EvalResult:
     num_images: int
     min_depth_m: float
     max_depth_m: float
+    size: str = "input"
 
     def row(self) -> dict[str, float]:
         """The metrics plus "ms_per_frame", as one table row."""
@@ -388,11 +391,13 @@ class Evaluation:
     max_depth_m: float
 
     def header(self) -> str:
-        """One line: the data, the number of frames, the sparse input and the depth range."""
-        n = next(iter(self.results.values())).num_images
+        """One line: the data, the number of frames, the sparse input, the depth range, and (with working_size)
+        that the models ran as `lipjax complete` runs them."""
+        first = next(iter(self.results.values()))
         own = " (the data's own sparse maps)" if self.data.spec.split(":")[0] == OWN_INPUT else ""
-        return (f"data: {self.data.name} ({n} frames), sampler: {self.data.spec}{own}, depth range: "
-                f"({self.min_depth_m:g}, {self.max_depth_m:g}] m")
+        path = ", models at the samples' working size (as lipjax complete)" if first.size == "working" else ""
+        return (f"data: {self.data.name} ({first.num_images} frames), sampler: {self.data.spec}{own}, depth range: "
+                f"({self.min_depth_m:g}, {self.max_depth_m:g}] m{path}")
 
 
 def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | None = None,
@@ -426,8 +431,9 @@ def evaluate_methods(models: Sequence[Any] | None = None, *, iterations: int | N
         label = (os.fspath(model) if isinstance(model, (str, os.PathLike))
                  else "untrained" if completer.name == "random" else completer.name)
         run = AtWorkingSize(completer) if working_size else completer
-        results[label] = evaluate(run, frames.dataset, frames.sampler, min_depth_m=min_depth, max_depth_m=max_depth,
-                                  limit=limit, progress=progress, seed=seed)
+        result = evaluate(run, frames.dataset, frames.sampler, min_depth_m=min_depth, max_depth_m=max_depth,
+                          limit=limit, progress=progress, seed=seed)
+        results[label] = dataclasses.replace(result, size="working") if working_size else result
     return Evaluation(results, frames, min_depth, max_depth)
 
 

@@ -459,6 +459,8 @@ def test_evaluate_working_size_scores_what_complete_returns(model, tmp_path):
         out = tmp_path / f"{len(flags)}.json"
         assert cli.main(["evaluate", "--model", model[0], "--data", "synthetic-indoor", "--size", "160", "200",
                          "--limit", "1", "--sampler", "uniform:20", "--quiet", "--json", str(out), *flags]) == 0
-        scores[tuple(flags)] = json.loads(out.read_text())[model[0]]["metrics"]
+        row = json.loads(out.read_text())[model[0]]
+        assert row["size"] == ("working" if flags else "input")  # the JSON says which path was scored
+        scores[tuple(flags)] = row["metrics"]
     assert scores[("--working-size",)]["mae_sampled_m"] == 0.0 < scores[()]["mae_sampled_m"]
     assert scores[("--working-size",)]["rmse_m"] != scores[()]["rmse_m"]

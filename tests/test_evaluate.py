@@ -164,7 +164,10 @@ def test_working_size_scores_the_default_path_not_the_model_at_the_input_size():
     model = Completer.random(LIPConfig(prior=network_preset("tiny"), num_iterations=1))
     kwargs = dict(data="synthetic-indoor", size=(160, 200), sampler="uniform:20", limit=2, progress=False)
     plain = evaluate_methods([model], **kwargs).results["untrained"]
-    default = evaluate_methods([model], working_size=True, **kwargs).results["untrained"]
+    report = evaluate_methods([model], working_size=True, **kwargs)
+    default = report.results["untrained"]
+    assert report.header().endswith("m, models at the samples' working size (as lipjax complete)")
+    assert (default.size, plain.size) == ("working", "input")
     sample = SyntheticDataset("indoor", "test", size=1, height=160, width=200)[0]
     sparse = sampler_from_spec("uniform:20")(sample, 0)
     assert frame_size(model, sparse) == (64, 80)

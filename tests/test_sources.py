@@ -357,7 +357,7 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
                            capture_output=True, text=True, timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
-                    "--depth-scale", "1000")
+                    "--depth-scale", "1000", "--fill-all")  # every pixel, as lipjax.complete returns them
     assert done.returncode == 0, done.stderr[-3000:]
     import lipjax
     from lipjax.data.folder import read_depth, read_rgb
