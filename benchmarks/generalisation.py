@@ -27,7 +27,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from lipjax.data.sampling import sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
 from lipjax.data.synthetic.dataset import MixedSyntheticDataset  # noqa: E402
-from lipjax.inference import complete_frame  # noqa: E402
+from lipjax.inference import CROSS_CHECK, complete_frame  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 ROOM, STREET = (480, 640), (352, 1216)
@@ -55,13 +55,14 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
     return list(SyntheticDataset(kind, "test", size=n, height=size[0], width=size[1], focal_range=focal))
 
 
-def ratio_to_linear(model, linear, sample, spec) -> float:
+def ratio_to_linear(model, linear, sample, spec, cross_check: bool = CROSS_CHECK) -> float:
     """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
-    pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0."""
-    return ratios_to_linear(model, linear, sample, spec, (sample.rgb,))[0]
+    pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0;
+    `cross_check` as in lipjax.inference.complete_at."""
+    return ratios_to_linear(model, linear, sample, spec, (sample.rgb,), cross_check)[0]
 
 
-def ratios_to_linear(model, linear, sample, spec, images) -> list[float]:
+def ratios_to_linear(model, linear, sample, spec, images, cross_check: bool = CROSS_CHECK) -> list[float]:
     """`ratio_to_linear` with each of `images` in place of the sample's own, the samples and the linear fill (which
     uses no image) computed once."""
     sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(sample, 0)
@@ -71,7 +72,7 @@ def ratios_to_linear(model, linear, sample, spec, images) -> list[float]:
         return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
 
     completer, reference = get_completer(model, sparse=sparse), rmse(linear(sample.rgb, sparse))
-    return [rmse(complete_frame(completer, rgb, sparse)) / reference for rgb in images]
+    return [rmse(complete_frame(completer, rgb, sparse, cross_check=cross_check)) / reference for rgb in images]
 
 
 def main(argv=None) -> None:
@@ -79,11 +80,13 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--frames", type=int, default=8, help="test frames per setting")
     ap.add_argument("--json", default=None, help="write the per-frame ratios here")
+    ap.add_argument("--no-cross-check", dest="cross_check", action="store_false",
+                    help="the model's estimate itself, without lipjax.crosscheck (how model suites are compared)")
     args = ap.parse_args(argv)
     linear, table = get_completer("linear"), {}
     for name, kind, size, spec, variant in SETTINGS:
         samples = frames(kind, size, variant, args.frames)
-        r = np.asarray([ratio_to_linear(args.model, linear, s, spec) for s in samples])
+        r = np.asarray([ratio_to_linear(args.model, linear, s, spec, args.cross_check) for s in samples])
         table[name] = r.tolist()
         print(f"{name:30s} geometric mean {np.exp(np.log(r).mean()):.3f}  wins {int((r < 1).sum())}/{len(r)}",
               flush=True)
@@ -92,7 +95,8 @@ def main(argv=None) -> None:
           f"{np.exp(np.log(every).mean()):.4f}, wins {int((every < 1).sum())}/{len(every)}")
     if args.json:
         with open(args.json, "w") as f:
-            json.dump({"model": args.model, "frames": args.frames, "ratios": table}, f, indent=1)
+            json.dump({"model": args.model, "frames": args.frames, "cross_check": args.cross_check,
+                       "ratios": table}, f, indent=1)
 
 
 if __name__ == "__main__":

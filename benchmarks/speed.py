@@ -2,13 +2,15 @@
 
 Run by hand (never a test):
 
-    python benchmarks/speed.py [--models default,onnx:default,lip-fast-indoor]
+    python benchmarks/speed.py [--models default,unchecked:default,onnx:default,lip-fast-indoor]
                                [--classical linear,nearest,ip_basic,colorization] [--repeats 5]
 
 Frames: synthetic test renders (the test split, never trained on) at 256x320 and 480x640 with 200 uniform points
 (a room) and at 352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
 through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its working size (lipjax.resolution),
-host fill, solver and resizes included. "default" is the model `lipjax complete` picks for the frame.
+host fill, solver and resizes included, and on scattered samples the check against the linear fill
+(lipjax.crosscheck); "unchecked:NAME" is the same without that check (`--no-cross-check`). "default" is the model
+`lipjax complete` picks for the frame.
 "onnx:NAME" (NAME a model or "default") is that model exported for the frame's size and sample count
 (lipjax.onnx_export: one graph, fill and resizes inside) and run under onnxruntime on the CPU with its default
 threads, spin-waiting off (on the 2-core machine shared with a training run, the spinning threads doubled its
@@ -43,7 +45,7 @@ SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
 
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--models", default="default,onnx:default,lip-fast-indoor")
+    ap.add_argument("--models", default="default,unchecked:default,onnx:default,lip-fast-indoor")
     ap.add_argument("--classical", default="linear,nearest,ip_basic,colorization")
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args(argv)
@@ -69,13 +71,13 @@ def main(argv=None) -> None:
 
 def _runner(name: str, rgb: np.ndarray, sparse: np.ndarray):
     """(a call that completes the frame, the cell's label) for a method name of --models / --classical."""
-    onnx = name.startswith("onnx:")
-    model = name.removeprefix("onnx:")
+    onnx, unchecked = name.startswith("onnx:"), name.startswith("unchecked:")
+    model = name.removeprefix("onnx:").removeprefix("unchecked:")
     completer = get_completer(None if model == "default" else model, sparse=sparse)
     h, w = frame_size(completer, sparse)
     label = f" [{completer.name} at {h}x{w}]" if model == "default" else ""
     if not onnx:
-        return (lambda: complete_frame(completer, rgb, sparse)), label
+        return (lambda: complete_frame(completer, rgb, sparse, cross_check=not unchecked)), label
     import onnxruntime as ort
 
     path = os.path.join(tempfile.mkdtemp(prefix="lipjax-speed-"), "model.onnx")

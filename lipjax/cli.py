@@ -3,7 +3,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
-                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--mirror] [--threads N]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--mirror] [--no-cross-check] [--threads N]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
@@ -49,7 +49,7 @@ def _cmd_complete(args) -> int:
     done = complete_files(
         args.rgb, args.depth, args.out, lidar=args.lidar, calib=args.calib, camera=args.camera,
         depth_scale=args.depth_scale, model=args.model, iterations=args.iterations, max_side=args.max_side,
-        out_format=args.out_format, color_range=args.color_range, ply=args.ply,
+        out_format=args.out_format, color_range=args.color_range, ply=args.ply, cross_check=args.cross_check,
         intrinsics=args.intrinsics or args.intrinsics_file, uncertainty=args.uncertainty,
         max_uncertainty=args.max_uncertainty, fill_all=args.fill_all, mirror=args.mirror, progress=not args.quiet,
         log=None if args.quiet else console.say, workers=min(args.threads or READ_WORKERS, READ_WORKERS))
@@ -155,6 +155,7 @@ def _add_complete_parser(sub) -> None:
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
     c.add_argument("--mirror", action="store_true", help="learned models: average with the mirror image (2x time)")
+    c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")

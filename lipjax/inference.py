@@ -20,7 +20,7 @@ from typing import Any
 import jax
 import numpy as np
 
-from lipjax import model_io
+from lipjax import crosscheck, model_io
 from lipjax.inputs import InputError, check_inputs, is_lidar_pattern  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
@@ -126,6 +126,12 @@ def default_model(scene: str = "indoor") -> Completer:
 # path keeps. Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
 MIRROR_AVERAGE = False
 
+# Whether the default path checks a learned model against the linear fill on held-out samples and leans on the
+# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: rule 33 of
+# docs/training.md, on synthetic frames. Off (`cross_check=False`, `lipjax complete --no-cross-check`): the model's
+# estimate alone, in half the time on scattered samples; what the ONNX graph computes.
+CROSS_CHECK = True
+
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
 LARGE_FRAME_PIXELS = 2_000_000
 
@@ -167,10 +173,11 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
-                   mirror: bool = MIRROR_AVERAGE) -> np.ndarray:
+                   mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`);
-    `max_side` caps the longer side instead (pixels), `mirror` as in `complete_at`."""
-    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror)
+    `max_side` caps the longer side instead (pixels), `mirror` and `cross_check` as in `complete_at`."""
+    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror,
+                       cross_check=cross_check)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -197,14 +204,16 @@ def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray)
 
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
-                mirror: bool = MIRROR_AVERAGE) -> np.ndarray:
+                mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear). Then, at any size, the final x-update runs at full size: with
     rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
     measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
-    With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why).
+    With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With
+    `cross_check` (CROSS_CHECK) a learned model's estimate of scattered samples is checked against the linear fill
+    on held-out samples and blended with it where it is the worse (`lipjax.crosscheck.cross_checked`).
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
     bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
     linear on 352x1216 streets with 64 beams.)
@@ -221,12 +230,17 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
     run = functools.partial(mirror_averaged, completer) if mirror else completer
-    if (h, w) == (big_h, big_w):
-        dense = np.array(run(rgb, sparse_m), np.float32)
-    else:
-        small_rgb = cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-        small = np.asarray(run(small_rgb, reproject_sparse(sparse_m, (h, w))), np.float32)
-        dense = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+    small_rgb = rgb if (h, w) == (big_h, big_w) else cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
+
+    def estimate(sparse: np.ndarray) -> np.ndarray:  # z at full size from a (H, W) sparse map, before any set-back
+        if (h, w) == (big_h, big_w):
+            return np.array(run(rgb, sparse), np.float32)
+        small = np.asarray(run(small_rgb, reproject_sparse(sparse, (h, w))), np.float32)
+        return cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+
+    dense = estimate(sparse_m)
+    if cross_check and isinstance(completer, Completer) and crosscheck.applies(sparse_m):
+        dense, _ = crosscheck.cross_checked(estimate, sparse_m, dense)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
     return dense

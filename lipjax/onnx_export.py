@@ -26,9 +26,9 @@ than the one lipjax trains with, see that module):
      except at a few pixels in a million (tests/test_fill.py). The host's "linear" (Delaunay) fill has no
      fixed-size program, so a model whose initial_estimate is "linear" or "auto" runs from the nearest fill in
      the graph: the same as its JAX result with the nearest fill, get that with
-     `lipjax.complete(rgb, sparse, model=nearest_twin(model))`. "auto" picks nearest for LiDAR scan lines, so
-     for scan lines such a model's export equals lipjax.complete; for scattered points it differs from its
-     linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m in the
+     `lipjax.complete(rgb, sparse, model=nearest_twin(model), cross_check=False)`. "auto" picks nearest for LiDAR
+     scan lines, so for scan lines such a model's export equals lipjax.complete; for scattered points it differs
+     from its linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m in the
      graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room
      (benchmarks/onnx_check.py --scattered). The shipped outdoor models use "nearest": their export equals
      lipjax.complete on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm, 99th percentile
@@ -37,7 +37,9 @@ than the one lipjax trains with, see that module):
      (cv2's INTER_LINEAR) and the measured pixels set back to their measured values. With `mirror=True`
      (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
      estimates are averaged after flipping the second back, as `lipjax.complete(..., mirror=True)` does.
-At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. No input
+At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
+of the model against the linear fill on held-out samples (lipjax.crosscheck; scattered samples only) is not in the
+graph (it needs the Delaunay fill): the graph is `lipjax.complete(..., cross_check=False)`. No input
 checks run inside the graph (check with `lipjax.inputs.check_inputs` where lipjax is installed); a frame without
 samples gives zeros.
 Speed (benchmarks/speed.py, 2-core machine): a KITTI frame took 69 ms under onnxruntime against 34 ms for the same

@@ -36,7 +36,7 @@ LAYERS = {
     "lipjax.model": 2, "lipjax.networks": 2, "lipjax.model_io": 2,
     # 3: running them: inference, the resolver, evaluation, training, export, files and folders on disk
     "lipjax.inference": 3, "lipjax.export": 3, "lipjax.uncertainty": 3, "lipjax.methods": 3, "lipjax.evaluate": 3,
-    "lipjax.train": 3, "lipjax.files": 3, "lipjax.onnx_export": 3,
+    "lipjax.train": 3, "lipjax.files": 3, "lipjax.onnx_export": 3, "lipjax.crosscheck": 3,
     # 4: the front doors
     "lipjax.cli": 4, "lipjax": 4,
 }

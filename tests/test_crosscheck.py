@@ -1,0 +1,114 @@
+"""The per-frame check of a learned model against the linear fill on held-out samples (lipjax.crosscheck)."""
+import math
+
+import numpy as np
+import pytest
+
+from lipjax import crosscheck
+from lipjax.classical.interpolate import linear_fill
+from lipjax.inference import Completer, complete_at
+from lipjax.model import LIPConfig
+
+
+def _plane(h=48, w=64):
+    """Depth of a tilted plane, metres: the linear fill of any samples of it is exact inside their hull."""
+    rows, cols = np.mgrid[0:h, 0:w]
+    return (2.0 + 0.02 * rows + 0.03 * cols).astype(np.float32)
+
+
+def _scattered(depth, n, seed=0):
+    rng = np.random.default_rng(seed)
+    out = np.zeros_like(depth)
+    idx = rng.choice(depth.size, n, replace=False)
+    out.reshape(-1)[idx] = depth.reshape(-1)[idx]
+    return out
+
+
+def _binomial_tail(k, n):
+    """P(Binomial(n, 1/2) >= k), summed term by term."""
+    return sum(math.comb(n, i) for i in range(k, n + 1)) / 2**n
+
+
+def test_the_model_gives_way_exactly_when_the_sign_test_says_so():
+    """n = 40 held-out samples: the model keeps w = 1 while it misses by more at k samples with
+    P(Bin(40, 1/2) >= k) >= 0.05, and gets the least-squares weight from the first k below that level."""
+    n = 40
+    first = next(k for k in range(n + 1) if _binomial_tail(k, n) < crosscheck.P_VALUE)
+    assert first == 26 and _binomial_tail(25, n) > 0.05  # 0.040 and 0.077
+    y = np.zeros(n)
+    x_l = np.full(n, -1.0)  # linear misses every sample by 1
+    for k in (first - 1, first):
+        x_m = np.where(np.arange(n) < k, 3.0, 0.5)  # the model misses k samples by 3, the others by 0.5
+        d = x_m - x_l
+        expected = 1.0 if k < first else float(np.clip(np.sum((y - x_l) * d) / np.sum(d * d), 0, 1))
+        assert crosscheck.blend_weight(y, x_m, x_l) == pytest.approx(expected, rel=1e-12)
+    assert expected < 1.0
+
+
+def test_a_model_worse_everywhere_gets_the_closed_form_weight():
+    """x_m = y + 3 e, x_l = y - e: w = sum (y - x_l)(x_m - x_l) / sum (x_m - x_l)^2 = 4 / 16 = 1/4, and the blend
+    w x_m + (1 - w) x_l is then y exactly."""
+    rng = np.random.default_rng(1)
+    y = rng.uniform(1, 9, 50)
+    e = rng.uniform(0.1, 1.0, 50) * rng.choice([-1, 1], 50)
+    w = crosscheck.blend_weight(y, y + 3 * e, y - e)
+    assert w == pytest.approx(0.25, rel=1e-12)
+    np.testing.assert_allclose(w * (y + 3 * e) + (1 - w) * (y - e), y, atol=1e-12)
+    assert crosscheck.blend_weight(y, y - e, y + 3 * e) == 1.0  # the better model is left alone
+    assert crosscheck.blend_weight(y, y + e, y + e) == 1.0  # equal estimates: nothing to weigh
+
+
+def test_hold_out_removes_a_fixed_fifth_of_the_samples():
+    sparse = _scattered(_plane(), 203)
+    kept, rows, cols = crosscheck.hold_out(sparse)
+    assert rows.size == round(0.2 * 203) == 41 and np.all(sparse[rows, cols] > 0) and np.all(kept[rows, cols] == 0)
+    restored = kept.copy()
+    restored[rows, cols] = sparse[rows, cols]
+    np.testing.assert_array_equal(restored, sparse)  # nothing else changed
+    again = crosscheck.hold_out(sparse)
+    np.testing.assert_array_equal(again[1], rows)
+    np.testing.assert_array_equal(again[2], cols)
+
+
+def test_it_applies_to_100_scattered_samples_or_more_and_never_to_scan_lines():
+    depth = _plane()
+    assert not crosscheck.applies(_scattered(depth, crosscheck.MIN_SAMPLES - 1))
+    assert crosscheck.applies(_scattered(depth, crosscheck.MIN_SAMPLES))
+    lines = np.zeros_like(depth)
+    lines[2::4] = depth[2::4]  # 12 full rows: 768 samples
+    assert not crosscheck.applies(lines)
+
+
+def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept():
+    """On a plane the linear fill is exact inside the samples' hull: an estimate 1 m off everywhere loses at every
+    held-out sample, and its weight is the least-squares one (near 0); the true depth itself is kept as it is."""
+    depth = _plane()
+    sparse = _scattered(depth, 300)
+    off = depth + 1.0
+    x, w = crosscheck.cross_checked(lambda s: off, sparse, off)
+    assert 0.0 <= w < 0.02
+    np.testing.assert_allclose(x, w * off + (1 - w) * linear_fill(sparse), rtol=1e-6)
+    inside = np.abs(linear_fill(sparse) - depth) < 1e-4
+    assert inside.mean() > 0.8 and np.abs(x - depth)[inside].max() < 0.021  # w * 1 m at most
+    x, w = crosscheck.cross_checked(lambda s: depth, sparse, depth)
+    assert w == 1.0 and x is depth
+
+
+def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
+    """An untrained model (identity prox) returns its nearest fill, worse than the linear fill on a plane: the
+    default path leans on the linear fill and comes closer to the depth, keeps every sample, and
+    cross_check=False returns the model's own estimate; on scan lines the check does not run."""
+    depth = _plane()
+    rgb = np.full(depth.shape + (3,), 128, np.uint8)
+    model = Completer.random(LIPConfig(initial_estimate="nearest"))
+    sparse = _scattered(depth, 300)
+    checked, plain = (complete_at(model, rgb, sparse, depth.shape, cross_check=c) for c in (True, False))
+    unsampled = sparse == 0
+    rmse = [float(np.sqrt(np.mean((x - depth)[unsampled] ** 2))) for x in (checked, plain)]
+    assert rmse[0] < 0.5 * rmse[1], rmse
+    np.testing.assert_array_equal(checked[~unsampled], sparse[~unsampled])
+    lines = np.zeros_like(depth)
+    lines[2::4] = depth[2::4]
+    with pytest.warns(UserWarning, match="trained on scattered points"):  # the untrained model's training
+        np.testing.assert_array_equal(complete_at(model, rgb, lines, depth.shape),
+                                      complete_at(model, rgb, lines, depth.shape, cross_check=False))
