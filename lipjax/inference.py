@@ -127,9 +127,10 @@ def default_model(scene: str = "indoor") -> Completer:
 MIRROR_AVERAGE = False
 
 # Whether the default path checks a learned model against the linear fill on held-out samples and leans on the
-# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: rule 33 of
-# docs/training.md, on synthetic frames. Off (`cross_check=False`, `lipjax complete --no-cross-check`): the model's
-# estimate alone, in half the time on scattered samples; what the ONNX graph computes.
+# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by a rule
+# on synthetic frames (docs/design-notes.md, "A check against the linear fill"). Off (`cross_check=False`, `lipjax
+# complete --no-cross-check`): the model's estimate alone, run once instead of twice on scattered samples (480x640
+# with 200 points: 143 against 238 ms, benchmarks/speed.py); what the ONNX graph computes.
 CROSS_CHECK = True
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
