@@ -1,5 +1,8 @@
 """Where the default model loses to a linear fill, per frame: at depth edges, at colour-only edges, or on flat ground.
 
+The model's own estimate is scored (`cross_check=False`): the default path's check against the linear fill
+(lipjax.crosscheck) would mix that fill into what is measured here.
+
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
     python benchmarks/failure_look.py [--model NAME] [--synthetic 8] [--realdata ../shared/realdata] [--plot PNG]
@@ -65,8 +68,8 @@ def frame_row(name: str, input_name: str, rgb, depth, valid, sparse, linear,
     completer = get_completer(model, sparse=sparse)
     keep = valid & (sparse <= 0) & (depth > 0)
     e_lin = np.where(keep, linear(rgb, sparse) - depth, 0.0)
-    e_rgb = np.where(keep, complete_frame(completer, rgb, sparse) - depth, 0.0)
-    e_grey = np.where(keep, complete_frame(completer, np.full_like(rgb, GREY), sparse) - depth, 0.0)
+    e_rgb = np.where(keep, complete_frame(completer, rgb, sparse, cross_check=False) - depth, 0.0)
+    e_grey = np.where(keep, complete_frame(completer, np.full_like(rgb, GREY), sparse, cross_check=False) - depth, 0.0)
     classes = pixel_classes(rgb, depth, valid)
     total = float((e_lin ** 2).sum())
     row = {"frame": name, "input": input_name, "ratio": float(np.sqrt((e_rgb ** 2).sum() / total)),

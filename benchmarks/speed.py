@@ -73,6 +73,8 @@ def _runner(name: str, rgb: np.ndarray, sparse: np.ndarray):
     """(a call that completes the frame, the cell's label) for a method name of --models / --classical."""
     onnx, unchecked = name.startswith("onnx:"), name.startswith("unchecked:")
     model = name.removeprefix("onnx:").removeprefix("unchecked:")
+    if ":" in model:
+        raise SystemExit(f"{name}: one prefix at most (onnx: or unchecked:; the ONNX graph holds no check)")
     completer = get_completer(None if model == "default" else model, sparse=sparse)
     h, w = frame_size(completer, sparse)
     label = f" [{completer.name} at {h}x{w}]" if model == "default" else ""

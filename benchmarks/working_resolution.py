@@ -1,5 +1,8 @@
 """Chooses the learned prox's working resolution on synthetic renders larger than the training frames.
 
+The model's own estimate is scored (`cross_check=False`): the default path's check against the linear fill
+(lipjax.crosscheck) would mix that fill into what is measured here.
+
     python benchmarks/working_resolution.py [--model lip-fast-indoor] [--frames 12] [--out runs/eval/working_res]
 
 Rooms rendered at 480x640 (NYU's size) and streets at 352x1216 (KITTI's), from the test split (never trained on),
@@ -67,7 +70,7 @@ def run(model: str, frames: int) -> dict:
             for t, p in RULES:
                 size = working_size((h, w), spacing, t, p)
                 if size not in by_size:  # rules that give the same size share one run
-                    pred = complete_at(completer, sample.rgb, sparse, size)
+                    pred = complete_at(completer, sample.rgb, sparse, size, cross_check=False)
                     by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"

@@ -240,7 +240,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         return cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
 
     dense = estimate(sparse_m)
-    if cross_check and isinstance(completer, Completer) and crosscheck.applies(sparse_m):
+    if cross_check and isinstance(completer, Completer):
         dense, _ = crosscheck.cross_checked(estimate, sparse_m, dense)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]

@@ -28,11 +28,11 @@ than the one lipjax trains with, see that module):
      the graph: the same as its JAX result with the nearest fill, get that with
      `lipjax.complete(rgb, sparse, model=nearest_twin(model), cross_check=False)`. "auto" picks nearest for LiDAR
      scan lines, so for scan lines such a model's export equals lipjax.complete; for scattered points it differs
-     from its linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m in the
-     graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room
+     from its linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m
+     in the graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room
      (benchmarks/onnx_check.py --scattered). The shipped outdoor models use "nearest": their export equals
-     lipjax.complete on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm, 99th percentile
-     at most 0.71 mm; benchmarks/onnx_check.py).
+     lipjax.complete on scan lines and, with cross_check=False, on any input (KITTI, 352x1216, HDL-64: median
+     |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR) and the measured pixels set back to their measured values. With `mirror=True`
      (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
@@ -168,7 +168,8 @@ class OnnxFile:
             lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
                          "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
         if self.mirror:
-            lines.append("mirror averaging in the graph: equal to lipjax.complete(..., mirror=True)")
+            lines.append("mirror averaging in the graph: equal to lipjax.complete(..., mirror=True, "
+                         "cross_check=False)")
         return "\n".join(lines)
 
 

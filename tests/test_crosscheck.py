@@ -55,7 +55,7 @@ def test_a_model_worse_everywhere_gets_the_closed_form_weight():
     assert w == pytest.approx(0.25, rel=1e-12)
     np.testing.assert_allclose(w * (y + 3 * e) + (1 - w) * (y - e), y, atol=1e-12)
     assert crosscheck.blend_weight(y, y - e, y + 3 * e) == 1.0  # the better model is left alone
-    assert crosscheck.blend_weight(y, y + e, y + e) == 1.0  # equal estimates: nothing to weigh
+    assert crosscheck.blend_weight(y, y + e, y + e) == 1.0  # equal estimates: the model is never worse
 
 
 def test_hold_out_removes_a_fixed_fifth_of_the_samples():
@@ -86,12 +86,18 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     sparse = _scattered(depth, 300)
     off = depth + 1.0
     x, w = crosscheck.cross_checked(lambda s: off, sparse, off)
-    assert 0.0 <= w < 0.02
+    kept, rows, cols = crosscheck.hold_out(sparse)
+    y, x_l = sparse[rows, cols], linear_fill(kept)[rows, cols]
+    d = off[rows, cols] - x_l
+    assert w == pytest.approx(np.clip(np.sum((y - x_l) * d) / np.sum(d * d), 0, 1), rel=1e-6) and 0.0 <= w < 0.02
     np.testing.assert_allclose(x, w * off + (1 - w) * linear_fill(sparse), rtol=1e-6)
     inside = np.abs(linear_fill(sparse) - depth) < 1e-4
     assert inside.mean() > 0.8 and np.abs(x - depth)[inside].max() < 0.021  # w * 1 m at most
     x, w = crosscheck.cross_checked(lambda s: depth, sparse, depth)
     assert w == 1.0 and x is depth
+    few = _scattered(depth, crosscheck.MIN_SAMPLES - 1)  # not checked: returned as it is
+    x, w = crosscheck.cross_checked(lambda s: off, few, off)
+    assert w == 1.0 and x is off
 
 
 def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
@@ -104,6 +110,7 @@ def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
     sparse = _scattered(depth, 300)
     checked, plain = (complete_at(model, rgb, sparse, depth.shape, cross_check=c) for c in (True, False))
     unsampled = sparse == 0
+    np.testing.assert_array_equal(plain[unsampled], model(rgb, sparse)[unsampled])  # the model's own estimate
     rmse = [float(np.sqrt(np.mean((x - depth)[unsampled] ** 2))) for x in (checked, plain)]
     assert rmse[0] < 0.5 * rmse[1], rmse
     np.testing.assert_array_equal(checked[~unsampled], sparse[~unsampled])

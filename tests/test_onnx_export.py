@@ -1,6 +1,6 @@
 """The ONNX export (lipjax.onnx_export, lipjax.jaxpr_to_onnx): under onnxruntime it computes what JAX computes,
 primitive by primitive and for a whole model, and equals `lipjax.complete` wherever the fill in its graph is the
-model's own."""
+model's own (and the default path's check against the linear fill does not run: scan lines, or under 100 samples)."""
 import math
 
 import jax
