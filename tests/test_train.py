@@ -378,6 +378,33 @@ def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_
         loop._initial_g_params(dataclasses.replace(CONFIG, model=other, init_from=str(tmp_path / "indoor")))
 
 
+def test_a_warm_start_records_its_data_and_warns_when_it_would_read_the_same_again(straight_run, tmp_path):
+    """Step s of a run reads what its config and seed give step s: a model records each run of its chain of warm
+    starts, and a run from it with a config and seed already in that chain warns (it repeats those frames)."""
+    import warnings
+
+    _, state = straight_run
+    loop.export(CONFIG, state, tmp_path / "first")
+    steps = CONFIG.total_steps
+    assert loop.data_streams(lipjax.load_model(tmp_path / "first").metadata) == [
+        {"train_config": "test", "seed": 0, "steps": steps}]
+    again = dataclasses.replace(CONFIG, init_from=str(tmp_path / "first"))
+    with pytest.warns(UserWarning, match="seed 0: this run reads the same frames.*--set seed=N"):
+        loop._initial_g_params(again)
+    fresh = dataclasses.replace(again, seed=7)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        loop._initial_g_params(fresh)  # a seed of its own: no warning
+    loop.export(fresh, state, tmp_path / "second")
+    assert loop.data_streams(lipjax.load_model(tmp_path / "second").metadata) == [
+        {"train_config": "test", "seed": 0, "steps": steps}, {"train_config": "test", "seed": 7, "steps": steps}]
+    with pytest.warns(UserWarning, match="seed 0"):  # the first run's stream is still in the chain
+        loop._initial_g_params(dataclasses.replace(CONFIG, init_from=str(tmp_path / "second")))
+    # a model saved before the streams were recorded read its config's with the default seed
+    assert loop.data_streams({"train_config": "lip-any", "images_seen": 8}) == [
+        {"train_config": "lip-any", "seed": 0, "steps": None}]
+
+
 # A run long enough to be killed mid-way (the straight CONFIG ends within a second of compiling), with one loader
 # worker process, checkpoints every 3 steps.
 KILLED = dataclasses.replace(CONFIG, name="killed", g_steps=24, d_steps=0, adv_steps=0, checkpoint_every=3,

@@ -88,7 +88,7 @@ class TrainConfig:
     eval_every: int = 500
     checkpoint_every: int = 100
     keep_checkpoints: int = 3
-    seed: int = 0
+    seed: int = 0  # the data stream (frames' order, samples, crops) and fresh weights; a warm start needs its own
     init_from: str | None = None
 
     def __post_init__(self):

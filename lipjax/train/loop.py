@@ -19,6 +19,7 @@ import pathlib
 import signal
 import threading
 import time
+import warnings
 from typing import Any
 
 import jax
@@ -70,7 +71,12 @@ def _initial_g_params(config: TrainConfig):
     parameter tree (names or shapes) is an error."""
     if config.init_from is None:
         return None
-    init_config, params, _ = model_io.load(config.init_from)
+    init_config, params, init_meta = model_io.load(config.init_from)
+    if {"train_config": config.name, "seed": config.seed} in [
+            {k: s.get(k) for k in ("train_config", "seed")} for s in data_streams(init_meta)]:
+        warnings.warn(f"init_from {config.init_from!r} already trained on {config.name}'s data with seed "
+                      f"{config.seed}: this run reads the same frames, samples and crops again from step 0; give "
+                      "it a seed of its own (--set seed=N) to train on new ones", stacklevel=2)
     if init_config != config.model:
         def shapes(tree):
             return jax.tree_util.tree_map(lambda a: tuple(a.shape), tree)
@@ -268,14 +274,28 @@ def train(
     return state
 
 
+def data_streams(metadata: dict) -> list[dict]:
+    """The training data a saved model has read, oldest run first: one {"train_config", "seed", "steps"} per run of
+    its chain of warm starts (`init_from`); step s of a run reads the frames, samples and crops that its config
+    and seed give step s, so two runs of one config and seed read the same data. A model saved before these were
+    recorded gives its last run's config with the default seed 0 (every run before then used it), steps unknown."""
+    if "data_streams" in metadata:
+        return list(metadata["data_streams"])
+    if "train_config" in metadata:
+        return [{"train_config": metadata["train_config"], "seed": 0, "steps": None}]
+    return []
+
+
 def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
            metadata: dict[str, Any] | None = None) -> None:
     """Saves the trained G as a loadable model (lipjax.load_model(path)), with its training budget: `images_seen`
     counts the training images of every step (batch size x steps), plus those of the model it started from; and
     with its training input, `train_sampler` (what lipjax.inputs checks scan lines against)."""
     params = jax.tree_util.tree_map(to_host, state.g_params)
-    before = model_io.metadata(config.init_from).get("images_seen", 0) if config.init_from else 0
+    init_meta = model_io.metadata(config.init_from) if config.init_from else {}
     meta = {"train_config": config.name, "steps": int(state.step),
-            "images_seen": before + int(state.step) * config.batch_size,
+            "images_seen": init_meta.get("images_seen", 0) + int(state.step) * config.batch_size,
+            "data_streams": data_streams(init_meta) + [{"train_config": config.name, "seed": config.seed,
+                                                        "steps": int(state.step)}],
             "train_sampler": config.data.train_sampler, **(metadata or {})}
     model_io.save(path, config.model, params, meta)
