@@ -290,7 +290,8 @@ def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
            metadata: dict[str, Any] | None = None) -> None:
     """Saves the trained G as a loadable model (lipjax.load_model(path)), with its training budget: `images_seen`
     counts the training images of every step (batch size x steps), plus those of the model it started from; and
-    with its training input, `train_sampler` (what lipjax.inputs checks scan lines against)."""
+    with its training input, `train_sampler` (what lipjax.inputs checks scan lines against), and the data every
+    run of its chain read, `data_streams`."""
     params = jax.tree_util.tree_map(to_host, state.g_params)
     init_meta = model_io.metadata(config.init_from) if config.init_from else {}
     meta = {"train_config": config.name, "steps": int(state.step),
