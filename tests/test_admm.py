@@ -134,7 +134,8 @@ def test_exact_quadratic_prox_converges_to_closed_form_solution():
 def test_gradients_flow_to_every_iterations_network():
     # Every iteration's network and rho_k get a gradient, except rho_0: with u_0 = 0 and a fill that keeps the
     # measured pixels (z_0 = y there), x_1 = (m y + rho_0 z_0) / (m + rho_0) is y on measured pixels and z_0
-    # elsewhere whatever rho_0, so its gradient is zero up to rounding.
+    # elsewhere whatever rho_0, so its gradient is zero up to float32 rounding (of z_0 rho_0 / rho_0 and
+    # (y + rho_0 y) / (1 + rho_0), ~1e-7 relative per pixel: 8e-7 here against 5e-3 for rho_1 with jax 0.10).
     config = lip_model.LIPConfig(prior=network_preset("tiny"), num_iterations=3, initial_estimate="box_fill")
     params = lip_model.init(config, jax.random.key(0))
     # The zero-initialised residual heads block gradients to the layers below them at init; give them small
@@ -157,6 +158,10 @@ def test_gradients_flow_to_every_iterations_network():
         assert np.isfinite(g).all(), path
         per_iteration = np.abs(g.reshape(g.shape[0], -1)).max(axis=1)
         if jax.tree_util.keystr(path) == "['log_rho']":
-            assert per_iteration[0] <= 1e-6 * per_iteration[1:].min(), per_iteration
+            assert per_iteration[0] <= 1e-3 * per_iteration[1:].min(), per_iteration
             per_iteration = per_iteration[1:]
         assert (per_iteration > 0).all(), (jax.tree_util.keystr(path), per_iteration)
+    # and the loss itself: rho_0 times e changes it only by rounding, rho_1 times e by far more
+    base = float(jax.jit(loss)(params))
+    moved = [float(jax.jit(loss)(dict(params, log_rho=params["log_rho"].at[k].add(1.0)))) for k in (0, 1)]
+    assert abs(moved[0] - base) <= 1e-6 * base and abs(moved[1] - base) > 1e-4 * base, (base, moved)
