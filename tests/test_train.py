@@ -383,6 +383,10 @@ def test_a_warm_start_records_its_data_and_warns_when_it_would_read_the_same_aga
     starts, and a run from it with a config and seed already in that chain warns (it repeats those frames)."""
     import warnings
 
+    def first_frames(seed):
+        return pipeline.BatchIterator(range(1000), 8, None, seed=seed).global_indices(0)
+
+    assert np.array_equal(first_frames(0), first_frames(0)) and not np.array_equal(first_frames(0), first_frames(7))
     _, state = straight_run
     loop.export(CONFIG, state, tmp_path / "first")
     steps = CONFIG.total_steps
