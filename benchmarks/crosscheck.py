@@ -21,6 +21,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from benchmarks.generalisation import ROOM, SETTINGS, frames, ratio_to_linear  # noqa: E402
+from lipjax.crosscheck import MIN_SAMPLES  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 
@@ -31,7 +32,7 @@ def main(argv=None) -> None:
     ap.add_argument("--json", default=None, help="write the per-frame ratios here")
     args = ap.parse_args(argv)
     settings = [(name, args.model, kind, size, spec, variant) for name, kind, size, spec, variant in SETTINGS
-                if not spec.startswith("lidar") and int(spec.split(":")[1]) >= 100]
+                if not spec.startswith("lidar") and int(spec.split(":")[1]) >= MIN_SAMPLES]
     settings += [("rooms 200 points, street model", "lip-fast-outdoor", "indoor", ROOM, "uniform:200", None),
                  ("rooms, dense depth with holes", args.model, "indoor", ROOM, "holes:0.3", None)]
     linear, table = get_completer("linear"), {}

@@ -82,6 +82,7 @@ def ratios_to_linear(model, linear, sample, spec, images, cross_check: bool = CR
 
 
 def geometric_mean(ratios) -> float:
+    """Geometric mean of positive ratios."""
     return float(np.exp(np.log(np.asarray(ratios, np.float64)).mean()))
 
 

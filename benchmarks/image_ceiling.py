@@ -47,7 +47,7 @@ from scipy import ndimage
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from benchmarks.edge_statistics import DEPTH_EDGE, log_depth_step  # noqa: E402
-from benchmarks.generalisation import ratios_to_linear  # noqa: E402
+from benchmarks.generalisation import geometric_mean, ratios_to_linear  # noqa: E402
 from benchmarks.real_frames import GREY, INDOOR_POINTS, frames_and_inputs  # noqa: E402
 from lipjax.classical import nearest_fill  # noqa: E402
 from lipjax.data.sampling import UniformSampler  # noqa: E402
@@ -82,10 +82,6 @@ def shading_image(depth: np.ndarray, valid: np.ndarray, intrinsics) -> np.ndarra
     normal *= -np.sign(normal[..., 2:3] + 1e-12)  # towards the camera (n_z < 0)
     light = np.asarray(LIGHT_DIR) / np.linalg.norm(LIGHT_DIR)
     return _grey_rgb(255 * (AMBIENT + (1 - AMBIENT) * np.clip(normal @ light, 0.0, 1.0)))
-
-
-def geomean(r) -> float:
-    return float(np.exp(np.log(np.asarray(r)).mean()))
 
 
 def variant_image(sample, variant: str) -> np.ndarray:
@@ -131,7 +127,7 @@ def main(argv=None) -> None:
     print("\n| frames | n | " + " | ".join(variants) + " | " + " | ".join(f"worth: {v}" for v in others) + " |")
     print("|---|---:|" + "---:|" * (len(variants) + len(others)))
     for group in ("real", "renders"):
-        g = {v: geomean([r[v] for r in rows if r["group"] == group]) for v in variants}
+        g = {v: geometric_mean([r[v] for r in rows if r["group"] == group]) for v in variants}
         n = sum(r["group"] == group for r in rows)
         print(f"| {group} | {n} | " + " | ".join(f"{g[v]:.3f}" for v in variants) + " | "
               + " | ".join(f"{g['grey'] / g[v]:.3f}" for v in others) + " |")

@@ -41,7 +41,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from benchmarks.failure_look import pixel_classes  # noqa: E402
-from benchmarks.generalisation import frames, ratios_to_linear  # noqa: E402
+from benchmarks.generalisation import frames, geometric_mean, ratios_to_linear  # noqa: E402
 from benchmarks.real_frames import GREY  # noqa: E402
 from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
@@ -108,11 +108,6 @@ NUISANCES = {  # name -> (sample, rng) -> sample
 }
 
 
-def geomean(r) -> float:
-    """Geometric mean of positive ratios."""
-    return float(np.exp(np.log(np.asarray(r)).mean()))
-
-
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
@@ -135,8 +130,9 @@ def main(argv=None) -> None:
             spoilt = [nuisance(s, np.random.default_rng(seed)) for s, seed in zip(clean, seeds)]
             image, grey = zip(*(ratios_to_linear(args.model, linear, s, spec, (s.rgb, np.full_like(s.rgb, GREY)),
                                                  cross_check=False) for s in spoilt))
-            print(f"| {scene} | {name} | {geomean(image):.3f} | {geomean(grey):.3f} | "
-                  f"{geomean(grey) / geomean(image):.3f} | {sum(r < 1 for r in image)}/{len(image)} |", flush=True)
+            g_image, g_grey = geometric_mean(image), geometric_mean(grey)
+            print(f"| {scene} | {name} | {g_image:.3f} | {g_grey:.3f} | {g_grey / g_image:.3f} | "
+                  f"{sum(r < 1 for r in image)}/{len(image)} |", flush=True)
 
 
 if __name__ == "__main__":

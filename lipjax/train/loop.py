@@ -72,8 +72,7 @@ def _initial_g_params(config: TrainConfig):
     if config.init_from is None:
         return None
     init_config, params, init_meta = model_io.load(config.init_from)
-    if {"train_config": config.name, "seed": config.seed} in [
-            {k: s.get(k) for k in ("train_config", "seed")} for s in data_streams(init_meta)]:
+    if any((s["train_config"], s["seed"]) == (config.name, config.seed) for s in data_streams(init_meta)):
         warnings.warn(f"init_from {config.init_from!r} already trained on {config.name}'s data with seed "
                       f"{config.seed}: this run reads the same frames, samples and crops again from step 0; give "
                       "it a seed of its own (--set seed=N) to train on new ones", stacklevel=2)
