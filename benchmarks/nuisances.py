@@ -20,6 +20,9 @@ takes the worth to about 1 on the renders is a candidate cause; one that leaves 
     relit                      a smooth gain field on the image (`lipjax.data.augment.relight`, strength 0.7)
     camera noise               2 % Gaussian noise and a JPEG round trip at quality 30-95 (`camera_noise`)
     texture, 3 patches         colour patterns without depth on 3 rectangles (`paint_texture`, strength 0.7)
+    floor reflections          the frame rendered again with a polished floor / wet road (the scene mirrored in
+                               it, lipjax.data.synthetic.renderer.Reflection, strength 0.05-0.3, blur 0.5-2 px):
+                               colour structure on one plane, as tiles, polished wood and wet asphalt show it
     no depth at edges          no valid depth at failure_look's "depth edge" pixels (within 3 px of a log-depth
                                step over 0.05 per pixel), as a structured-light or stereo camera loses it: neither
                                samples nor ground truth there, where the image helps most on the renders
@@ -44,6 +47,8 @@ from benchmarks.failure_look import pixel_classes  # noqa: E402
 from benchmarks.generalisation import frames, geometric_mean, ratios_to_linear  # noqa: E402
 from benchmarks.real_frames import GREY  # noqa: E402
 from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
+from lipjax.data.synthetic import render_with_info  # noqa: E402
+from lipjax.data.synthetic.renderer import Reflection  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 SCENES = (("rooms 200 points", "indoor", (480, 640), "uniform:200"),
@@ -94,6 +99,14 @@ def textured(sample, patches: int, rng: np.random.Generator):
     return with_rgb(sample, rgb)
 
 
+def reflected(sample, rng: np.random.Generator):
+    """The test render `sample` drawn again with a reflecting floor (its depth, scene and noise unchanged)."""
+    _, kind, split, index = sample.id.split("/")
+    reflection = Reflection(float(rng.uniform(0.05, 0.3)), float(rng.uniform(0.5, 2.0)))
+    again, _ = render_with_info(kind, split, int(index), *sample.depth.shape, reflection=reflection)
+    return with_rgb(sample, again.rgb)
+
+
 NUISANCES = {  # name -> (sample, rng) -> sample
     "none": lambda s, rng: s,
     "RGB shifted by 2 px": lambda s, rng: shifted(s, 2),
@@ -104,6 +117,7 @@ NUISANCES = {  # name -> (sample, rng) -> sample
     "relit": lambda s, rng: with_rgb(s, relight(s.rgb, 0.7, rng)),
     "camera noise": lambda s, rng: with_rgb(s, camera_noise(s.rgb, Augment(sensor_noise=0.02, jpeg_prob=1.0), rng)),
     "texture, 3 patches": lambda s, rng: textured(s, 3, rng),
+    "floor reflections": reflected,
     "no depth at edges": lambda s, rng: edges_lost(s),
 }
 

@@ -25,7 +25,7 @@ from lipjax.data.synthetic.constants import (
     SYNTHETIC_KINDS,
 )
 from lipjax.data.synthetic.far_view import add_far_view, check_far_view_prob
-from lipjax.data.synthetic.renderer import render_scene
+from lipjax.data.synthetic.renderer import Reflection, render_scene
 from lipjax.data.synthetic.scenes import build_scene
 
 
@@ -143,12 +143,14 @@ def far_view_rng(split: str, index: int) -> np.random.Generator:
 
 def render_with_info(
     kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
-    focal_range: tuple[float, float] = (1.0, 1.0),
+    focal_range: tuple[float, float] = (1.0, 1.0), reflection: Reflection | None = None,
 ) -> tuple[Sample, SceneInfo]:
     """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
 
     `focal_range`: the camera's focal lengths are intrinsics_for(kind, H, W)'s times `focal_factor` (principal
     point kept): below 1 a wider field of view, above 1 a narrower one, the same scene and pose.
+    `reflection`: a polished floor or wet road (lipjax.data.synthetic.renderer.Reflection), the same scene, depth
+    and sensor noise; None: matte, as every data set of this package renders its frames.
 
     Raises:
       ValueError: unknown kind / split, a negative or non-integer index, or a size below 8 pixels.
@@ -163,7 +165,7 @@ def render_with_info(
     if f != 1.0:
         intr = dataclasses.replace(intr, fx=intr.fx * f, fy=intr.fy * f)
     with np.errstate(all="ignore"):
-        rgb, depth, labels = render_scene(scene, height, width, intr, noise_rng)
+        rgb, depth, labels = render_scene(scene, height, width, intr, noise_rng, reflection)
     sample = Sample.from_depth(rgb, depth, intr, sample_id(kind, split, index))
     pose = np.eye(4)
     pose[:3, :3] = scene.cam_R

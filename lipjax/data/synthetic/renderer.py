@@ -1,4 +1,5 @@
-"""The frame renderer: visibility, surfaces, lighting (shadows, gloss, haze, sky), then the camera model."""
+"""The frame renderer: visibility, surfaces, lighting (shadows, gloss, haze, sky, optional floor reflections), then
+the camera model."""
 from __future__ import annotations
 
 import dataclasses
@@ -9,8 +10,8 @@ import numpy as np
 from lipjax.data.sample import Intrinsics
 from lipjax.data.synthetic.arrays import _cols, _set_cols
 from lipjax.data.synthetic.camera import _camera_image
-from lipjax.data.synthetic.constants import _F32, _ROAD, _TERRAIN
-from lipjax.data.synthetic.primitives import _cache_hulls
+from lipjax.data.synthetic.constants import _F32, _FLOOR, _ROAD, _TERRAIN
+from lipjax.data.synthetic.primitives import _cache_hulls, _Ground
 from lipjax.data.synthetic.scene import Light, Scene
 from lipjax.data.synthetic.shadows import _shadows
 from lipjax.data.synthetic.surfaces import _surfaces
@@ -159,11 +160,76 @@ def _paint_sky(scene: Scene, lin: np.ndarray, sky_px: np.ndarray, intr: Intrinsi
         np.copyto(lin[c], cv2.resize(small[c], (W, H), interpolation=cv2.INTER_LINEAR).ravel(), where=sky_px)
 
 
-def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics,
-                 noise_rng) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+@dataclasses.dataclass(frozen=True)
+class Reflection:
+    """A polished floor or a wet road: the scene mirrored in the plane y = 0 seen on it; the depth is untouched.
+
+    On the floor and road pixels the radiance is L = (1 - F) L_surface + F L_mirror, with Schlick's Fresnel term
+    F = strength + (1 - strength) (1 - cos theta)^5 (theta: the view ray's angle to the floor's normal), so the
+    mirror image is faint looking down and strong at grazing angles. L_mirror is what the camera mirrored in
+    y = 0 sees (the same scene, rendered at half size), blurred by a Gaussian of `blur_px` pixels (the gloss's
+    roughness). Photographs of rooms and streets are full of such images (tiled and polished floors, wet
+    asphalt): colour structure where the geometry is one plane.
+    """
+
+    strength: float  # reflectance at normal incidence, in (0, 1]
+    blur_px: float = 1.0  # sigma of the roughness blur, full-size pixels; 0: a sharp mirror
+
+    def __post_init__(self):
+        if not 0 < self.strength <= 1 or not self.blur_px >= 0:
+            raise ValueError(f"Reflection needs 0 < strength <= 1 and blur_px >= 0, got {self}")
+
+
+_MIRROR_Y = np.diag([1.0, -1.0, 1.0])  # the reflection in the plane y = 0
+
+
+def _mirror_radiance(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics, blur_px: float) -> np.ndarray:
+    """(3, H * W) linear radiance that the camera mirrored in y = 0 sees, rendered at half size and upsampled.
+
+    The mirrored camera's ray through a pixel is the reflection of the camera's ray: it crosses y = 0 where the
+    camera's ray meets the floor and goes on into the scene as the reflected ray would. The ground plane is left
+    out (the mirrored ray crosses it from below); a room's shell is an inside box, whose far side is what the ray
+    leaves through."""
+    mirrored = dataclasses.replace(scene, cam_pos=np.asarray(scene.cam_pos, np.float64) * (1.0, -1.0, 1.0),
+                                   cam_R=_MIRROR_Y @ scene.cam_R)
+    kept = [p for p in prims if not isinstance(p, _Ground)]
+    h, w = (H + 1) // 2, (W + 1) // 2
+    half = Intrinsics(intr.fx / 2, intr.fy / 2, intr.cx / 2, intr.cy / 2)  # pixel 2 i of the frame is pixel i
+    rays = _CameraRays(mirrored, h, w, half)
+    zbuf, ids = _visibility(kept, mirrored, rays, half)
+    s = _surfaces_of(kept, mirrored, rays, zbuf, ids, half)
+    lin = _shade(mirrored, s, half, h, w)
+    if scene.sky is not None and (~s.hit).any():
+        _paint_sky(mirrored, lin, ~s.hit, half, h, w)
+    out = np.empty((3, H * W), _F32)
+    for c in range(3):
+        full = cv2.resize(lin[c].reshape(h, w), (W, H), interpolation=cv2.INTER_LINEAR)
+        if blur_px > 0:
+            full = cv2.GaussianBlur(full, (0, 0), blur_px, borderType=cv2.BORDER_REPLICATE)
+        out[c] = full.ravel()
+    return out
+
+
+def _reflect(scene: Scene, prims: list, s: _Surfaces, lin: np.ndarray, reflection: Reflection, intr: Intrinsics,
+             H: int, W: int) -> None:
+    """Blends the mirror image into the (3, N) `lin` on the floor and road pixels (see `Reflection`)."""
+    on_floor = (s.hit & np.isin(s.labels, (_FLOOR, _ROAD)) & (s.n[1] > 0.99) & (np.abs(s.p[1]) < 1e-2))
+    if not on_floor.any():
+        return
+    dx, dy, dz = (a[on_floor] for a in s.d)
+    cos = np.clip(-dy / np.sqrt(dx * dx + dy * dy + dz * dz), 0.0, 1.0)
+    f = reflection.strength + (1.0 - reflection.strength) * (1.0 - cos) ** 5
+    mirror = _mirror_radiance(scene, prims, H, W, intr, reflection.blur_px)
+    idx = np.flatnonzero(on_floor)
+    _set_cols(lin, idx, (1.0 - f) * _cols(lin, idx) + f * _cols(mirror, idx))
+
+
+def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics, noise_rng,
+                 reflection: Reflection | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Draws `scene` through the camera `intr` at H x W pixels; `noise_rng` (a numpy Generator) draws the sensor
-    noise. Returns (rgb (H, W, 3) uint8, z-depth (H, W) float32 metres (0: nothing within scene.max_depth),
-    labels (H, W) int8 (index into LABELS, 0 = sky))."""
+    noise; `reflection`: a polished floor / wet road (`Reflection`), None: matte. Returns (rgb (H, W, 3) uint8,
+    z-depth (H, W) float32 metres (0: nothing within scene.max_depth), labels (H, W) int8 (index into LABELS,
+    0 = sky))."""
     prims = _by_material(scene.prims)
     _cache_hulls(prims)
     rays = _CameraRays(scene, H, W, intr)
@@ -172,6 +238,8 @@ def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics,
     lin = _shade(scene, s, intr, H, W)
     if scene.sky is not None and (~s.hit).any():
         _paint_sky(scene, lin, ~s.hit, intr, H, W)
+    if reflection is not None:
+        _reflect(scene, prims, s, lin, reflection, intr, H, W)
     rgb = _camera_image(lin, scene, H, W, noise_rng)
     zf = zbuf.ravel()
     depth = np.where(s.hit & (zf <= scene.max_depth), zf, 0.0).astype(_F32).reshape(H, W)
