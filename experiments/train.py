@@ -4,6 +4,7 @@
     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
     python -m experiments.train --config lip_cnn_indoor --export-only --export PATH   # the latest checkpoint
     python -m experiments.train --config lip_cnn_indoor --export-only --average 4 --export PATH  # mean of 4
+    python -m experiments.train --config lip_any --soup OLDER,NEWER --export PATH  # mean of models of one chain
 
 A killed run resumes from its last checkpoint when started again with the same workdir. The run writes only into
 its workdir (checkpoints, metrics.jsonl, curves.png); the model is exported only to --export PATH.
@@ -15,7 +16,7 @@ import sys
 
 from lipjax.console import ArgumentParser, one_line, run_main
 from lipjax.train.config import parse_overrides
-from lipjax.train.run import run
+from lipjax.train.run import run, soup
 from lipjax.utils import enable_compilation_cache
 
 PROG = "python -m experiments.train"  # how it is run (also right as a script: no __spec__)
@@ -30,10 +31,13 @@ def main(argv=None) -> None:
     p.add_argument("--export-only", action="store_true", help="export the latest checkpoint without training")
     p.add_argument("--average", type=int, default=1, metavar="N",
                    help="export the mean parameters of the newest N checkpoints (checkpoint averaging; default 1)")
+    p.add_argument("--soup", default=None, metavar="MODEL,MODEL",
+                   help="export the mean parameters of saved models of one chain of warm starts, newest last "
+                        "(model soup; validated on --config's validation set; trains nothing)")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
-    if args.export_only and args.export is None:
-        p.error("--export-only needs --export PATH")
+    if (args.export_only or args.soup) and args.export is None:
+        p.error(f"{'--soup' if args.soup else '--export-only'} needs --export PATH")
     from experiments.configs import get_config
 
     try:
@@ -41,6 +45,9 @@ def main(argv=None) -> None:
     except ValueError as exc:  # an unknown config or field, or a bad value: a usage error
         p.error(one_line(exc))
     enable_compilation_cache()
+    if args.soup:
+        soup(config, [m.strip() for m in args.soup.split(",")], args.export)
+        return
     run(config, args.workdir or f"runs/{args.config}", export=args.export, export_only=args.export_only,
         average=args.average, progress=not args.no_progress)
 

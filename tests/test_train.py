@@ -97,6 +97,41 @@ def test_export_averages_the_newest_checkpoints(straight_run, tmp_path):
         run(CONFIG, workdir, export=tmp_path / "avg9", export_only=True, average=9, progress=False)
 
 
+def test_a_soup_is_the_mean_of_models_of_one_chain_with_the_newest_models_budget(straight_run, tmp_path):
+    """`soup` saves the element-wise mean of G's parameters over models of one chain of warm starts, validated on
+    the config's validation set, with the newest model's budget; a model from outside the chain, or of another
+    architecture, is a one-line error."""
+    from lipjax.train.run import soup
+
+    workdir, state = straight_run
+    manager = CheckpointManager(workdir / "checkpoints", keep=CONFIG.keep_checkpoints)
+    older = manager.restore(init_state(CONFIG), 6)[0]
+    manager.close()
+    loop.export(CONFIG, older, tmp_path / "first")
+    newer = dataclasses.replace(CONFIG, init_from=str(tmp_path / "first"), seed=7)
+    loop.export(newer, state, tmp_path / "second")
+    val = soup(CONFIG, [str(tmp_path / "first"), str(tmp_path / "second")], tmp_path / "soup")
+    model = lipjax.load_model(tmp_path / "soup")
+    for got, a, b in zip(*(jax.tree_util.tree_leaves(t) for t in (model.params, older.g_params, state.g_params))):
+        np.testing.assert_allclose(np.asarray(got), (np.asarray(a) + np.asarray(b)) / 2, rtol=1e-6, atol=1e-7)
+    second = lipjax.load_model(tmp_path / "second").metadata
+    assert model.metadata["images_seen"] == second["images_seen"] == (6 + 8) * CONFIG.batch_size  # step 6, then 8
+    assert model.metadata["data_streams"] == second["data_streams"] and len(second["data_streams"]) == 2
+    assert model.metadata["soup"] == [str(tmp_path / "first"), str(tmp_path / "second")]
+    assert model.metadata["val_metrics"] == val
+    alone = loop.evaluate_params(CONFIG.model, model.params, loop.validation_batches(CONFIG), CONFIG.model.max_depth_m)
+    assert val["rmse_m"] == pytest.approx(alone["rmse_m"], rel=1e-6)
+    loop.export(dataclasses.replace(CONFIG, seed=3), state, tmp_path / "stranger")  # its own chain
+    with pytest.raises(ValueError, match="stranger is not in .*second's chain of warm starts"):
+        soup(CONFIG, [str(tmp_path / "stranger"), str(tmp_path / "second")], tmp_path / "bad")
+    other = dataclasses.replace(CONFIG, model=dataclasses.replace(CONFIG.model, num_iterations=2))
+    lipjax.model_io.save(tmp_path / "wider", other.model, init_state(other).g_params, second)
+    with pytest.raises(ValueError, match="differ in architecture"):
+        soup(CONFIG, [str(tmp_path / "wider"), str(tmp_path / "second")], tmp_path / "bad")
+    with pytest.raises(ValueError, match="at least two models"):
+        soup(CONFIG, [str(tmp_path / "second")], tmp_path / "bad")
+
+
 def test_discriminator_phase_keeps_generator_frozen(straight_run):
     workdir, _ = straight_run
     manager = CheckpointManager(workdir / "checkpoints")
@@ -247,6 +282,7 @@ def test_config_overrides_reach_nested_fields_convert_types_and_reject_unknown_n
     (["--config", "nope"], "unknown config 'nope'"),
     (["--config", "smoke", "--set", "g_step=3"], "unknown config field 'g_step'"),
     (["--config", "smoke", "--set", "g_steps"], "expected FIELD=VALUE"),
+    (["--config", "smoke", "--soup", "a,b"], "--soup needs --export PATH"),
 ])
 def test_train_command_errors_are_one_line(args, message, capsys):
     from experiments import train as train_command

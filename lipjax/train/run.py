@@ -1,6 +1,7 @@
 """A whole training run as one call: train (or resume) in a workdir, validate, plot, export only where asked.
 
     run(config, "runs/lip_cnn_nyu", export="runs/lip_cnn_nyu/model")
+    soup(config, ["runs/export/a", "runs/export/b"], "runs/export/soup")   # the mean of saved models of one chain
     fine_tune_folder("my_frames", "models/mine", depth_scale=1000)   # `lipjax train`: the default model, fine-tuned
 
 Used by `python -m experiments.train` and (through `fine_tune_folder`) `lipjax train`. Nothing is written outside
@@ -25,7 +26,7 @@ from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
 from lipjax.train.folder import check_frames, default_init, folder_config
-from lipjax.train.loop import evaluate_params, export as export_model, train, validation_batches
+from lipjax.train.loop import data_streams, evaluate_params, export as export_model, train, validation_batches
 from lipjax.train.state import init_state
 
 
@@ -55,6 +56,38 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
         manager.close()
     mean = jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype), *trees)
     return mean, steps
+
+
+def soup(config: TrainConfig, models: list[str], export: str | os.PathLike) -> dict:
+    """Model soup: saves to `export` the element-wise mean of G's parameters over saved `models` (names or paths)
+    of one chain of warm starts, validated on `config`'s validation set; returns its validation metrics (metres).
+
+    Each model's training data (`lipjax.train.loop.data_streams`) must be part of the last one's: the last model
+    was warm-started, directly or through others, from each of the others (or is a sibling export of its run), so
+    the mean lies between points of one basin, as checkpoint averaging's does across one run, and the soup has
+    read exactly the last model's data. Its metadata is the last model's (images_seen, data_streams, ...) with the
+    soup's validation and `soup`: the models it is the mean of.
+    """
+    if len(models) < 2:
+        raise ValueError(f"--soup needs at least two models, got {models}")
+    loaded = [model_io.load(m) for m in models]
+    arch = {json.dumps(model_io.config_to_dict(c), sort_keys=True) for c, _, _ in loaded}
+    if len(arch) > 1:
+        raise ValueError(f"--soup: {', '.join(models)} differ in architecture; average models of one config")
+    last_streams = data_streams(loaded[-1][2])
+    for name, (_, _, meta) in zip(models, loaded):
+        streams = data_streams(meta)
+        if not streams or last_streams[:len(streams)] != streams:
+            raise ValueError(f"--soup: {name} is not in {models[-1]}'s chain of warm starts (its training data is "
+                             "not part of the last model's); list models of one chain, the newest last")
+    check_writable(pathlib.Path(export).parent, "the soup (--export)")
+    model = loaded[-1][0]
+    mean = jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype),
+                                  *(params for _, params, _ in loaded))
+    val = evaluate_params(model, mean, validation_batches(config), model.max_depth_m)
+    model_io.save(export, model, mean, {**loaded[-1][2], "val_metrics": val, "soup": [str(m) for m in models]})
+    print(f"[lipjax] exported the soup of {', '.join(map(str, models))} to {export}: val rmse_m={val['rmse_m']:.4f}")
+    return val
 
 
 def check_writable(folder: str | os.PathLike, what: str) -> None:
