@@ -1,6 +1,7 @@
 """Training throughput: input pipeline frames/s per source and worker count, host cost per frame, train-step rate.
 
     python benchmarks/train_throughput.py [--steps 12] [--workers 1 2] [--models lip_cnn_indoor lip_fast_indoor ...]
+    python benchmarks/train_throughput.py --sources --models lip_any     # the train step alone
 
 1. Pipeline: frames/s of lipjax.data.pipeline.TrainLoader (reading, sparse sampling, augment + crop and the host
    z0 fill, all in the grain worker processes) for each source, with each worker count. Real formats are written
@@ -151,12 +152,31 @@ def train_step_rate(name: str, steps: int) -> tuple[float, tuple[int, int]]:
     return steps * BATCH / (time.perf_counter() - start), (h, w)
 
 
+def pipeline_table(args, base, model) -> None:
+    """The host z0 fill's cost, then the pipeline table: host ms/frame and frames/s per worker count, per source."""
+    print(f"host z0 fill alone, one {CROP[0]}x{CROP[1]} frame, 200 points: linear {fill_ms('linear'):.1f} ms, "
+          f"nearest {fill_ms('nearest'):.1f} ms of CPU")
+    with tempfile.TemporaryDirectory() as tmp:
+        overrides = _write_fixtures(Path(tmp), frames=4 * BATCH)
+        print(f"\n| source | host ms/frame (1 process, {CROP[0]}x{CROP[1]} crop, z0 linear) | "
+              + " | ".join(f"frames/s, {w} worker{'s' * (w > 1)}" for w in args.workers) + " | speed-up |")
+        print("|---|---:|" + "---:|" * len(args.workers) + "---:|")
+        for name in args.sources:
+            data = dataclasses.replace(base, source=name, **overrides[name])
+            host = host_ms_per_frame(data, model, max(2, args.steps // 4))
+            rounds = [[pipeline_rate(data, model, w, args.steps) for w in args.workers]
+                      for _ in range(args.rounds)]  # interleaved, so that a burst of other load hits all counts
+            rates = [float(np.median(r)) for r in zip(*rounds)]
+            print(f"| {name} | {host:.1f} | " + " | ".join(f"{r:.1f}" for r in rates)
+                  + f" | {rates[-1] / rates[0]:.2f}x |", flush=True)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--steps", type=int, default=24, help="timed batches of 8 per measurement")
     p.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     p.add_argument("--rounds", type=int, default=3, help="measurements per worker count (median reported)")
-    p.add_argument("--sources", nargs="+", default=list(SOURCES), choices=SOURCES)
+    p.add_argument("--sources", nargs="*", default=list(SOURCES), choices=SOURCES, help="none: no pipeline table")
     p.add_argument("--models", nargs="*", default=["lip_cnn_indoor", "lip_fast_indoor", "ma2018_indoor",
                                                    "unet_indoor", "cspn_indoor"])
     p.add_argument("--model-steps", type=int, default=5)
@@ -170,22 +190,8 @@ def main() -> None:
 
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start; 2048x2048 float32 "
           f"matmul {matmul_rate(10)[1]:.0f} GFLOP/s (divide rates by it to compare machines or loads)")
-    base = dataclasses.replace(LIP_CNN_INDOOR.data, crop=CROP)
-    print(f"host z0 fill alone, one {CROP[0]}x{CROP[1]} frame, 200 points: linear {fill_ms('linear'):.1f} ms, "
-          f"nearest {fill_ms('nearest'):.1f} ms of CPU")
-    with tempfile.TemporaryDirectory() as tmp:
-        overrides = _write_fixtures(Path(tmp), frames=4 * BATCH)
-        print(f"\n| source | host ms/frame (1 process, {CROP[0]}x{CROP[1]} crop, z0 linear) | "
-              + " | ".join(f"frames/s, {w} worker{'s' * (w > 1)}" for w in args.workers) + " | speed-up |")
-        print("|---|---:|" + "---:|" * len(args.workers) + "---:|")
-        for name in args.sources:
-            data = dataclasses.replace(base, source=name, **overrides[name])
-            host = host_ms_per_frame(data, LIP_CNN_INDOOR.model, max(2, args.steps // 4))
-            rounds = [[pipeline_rate(data, LIP_CNN_INDOOR.model, w, args.steps) for w in args.workers]
-                      for _ in range(args.rounds)]  # interleaved, so that a burst of other load hits all counts
-            rates = [float(np.median(r)) for r in zip(*rounds)]
-            print(f"| {name} | {host:.1f} | " + " | ".join(f"{r:.1f}" for r in rates)
-                  + f" | {rates[-1] / rates[0]:.2f}x |", flush=True)
+    if args.sources:
+        pipeline_table(args, dataclasses.replace(LIP_CNN_INDOOR.data, crop=CROP), LIP_CNN_INDOOR.model)
     if args.models:
         import jax
 

@@ -116,6 +116,12 @@ def _upsampled_kernel(kernel):
     return both.transpose(3, 1, 4, 2, 0, 5).reshape(2, 2, kernel.shape[2], 4 * kernel.shape[3])
 
 
+def _upsampled_conv_plain(low, kernel):
+    """_conv(upsample2(low), kernel) as written: the x2 nearest-upsampled map, then the 3x3 convolution."""
+    return _conv(jnp.repeat(jnp.repeat(low, 2, axis=1), 2, axis=2), kernel)
+
+
+@jax.custom_vjp
 def _upsampled_conv(low, kernel):
     """_conv(upsample2(low), kernel) computed at the low resolution: (B, h, w, C_in) -> (B, 2h, 2w, C_out).
 
@@ -124,12 +130,28 @@ def _upsampled_conv(low, kernel):
     the kernel's taps summed (`_upsampled_kernel`). The four run as one 2x2 convolution of 4 C_out channels over the
     low map padded by one zero pixel (the upsampled map's zero padding), with 4/9 of the multiply-adds and no
     upsampled map in memory; phase (a, b) is read at offset (a, b) of its output.
+
+    The gradient is that of the same map written plainly (`_upsampled_conv_plain`, equal in exact arithmetic):
+    XLA's CPU backward of the phase form (its kernel sums, the 2x2 convolution, the phase slices) took 4-8x as long
+    (a training step of lip_any 2.3 s, against 0.2 s for its forward), the plain form's is an ordinary
+    convolution's (benchmarks/train_step.py).
     """
     b, h, w, _ = low.shape
     c = kernel.shape[3]
     y = _conv(low, _upsampled_kernel(kernel), padding=((1, 1), (1, 1))).reshape(b, h + 1, w + 1, 2, 2, c)
     phases = jnp.stack([jnp.stack([y[:, a:a + h, p:p + w, a, p] for p in (0, 1)], axis=3) for a in (0, 1)], axis=2)
     return phases.reshape(b, 2 * h, 2 * w, c)  # (B, h, a, w, b, C) -> (B, 2h, 2w, C)
+
+
+def _upsampled_conv_fwd(low, kernel):
+    return _upsampled_conv(low, kernel), (low, kernel)
+
+
+def _upsampled_conv_bwd(residuals, g):
+    return jax.vjp(_upsampled_conv_plain, *residuals)[1](g)
+
+
+_upsampled_conv.defvjp(_upsampled_conv_fwd, _upsampled_conv_bwd)
 
 
 def _up_conv_norm_relu(low, skip, features: int, index: int):
