@@ -124,7 +124,7 @@ def test_the_upsampling_convolution_and_its_gradient_are_those_of_upsample_then_
                     argnums=(0, 1))(low, kernel)
     for a, b in zip(got, want):
         np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-5)
-    # the upsampled map's gradient in `low` sums each 2x2 block's: a linear map's adjoint, checked by <Ax, y> = <x, A*y>
+    # the gradient in `low` sums each 2x2 block's: a linear map's adjoint, checked by <Ax, y> = <x, A* y>
     np.testing.assert_allclose((plain * weights).sum(), (got[0] * low).sum(), rtol=1e-4)
 
 
