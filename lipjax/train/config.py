@@ -38,6 +38,9 @@ class DataConfig:
     NYU v2's and KITTI's. Validation keeps the reference camera, so that runs stay comparable.
     far_view_prob: source synthetic, kind mixed, training frames only: the probability that a room shows a street
     through a window (lipjax.data.synthetic.far_view): far samples inside rooms. Validation keeps closed rooms.
+    clutter_prob: source synthetic, rooms (kind indoor or mixed), training frames only: the probability that a room
+    has things of many sizes on its floor where the camera looks (lipjax.data.synthetic.clutter). Validation keeps
+    the rooms as built.
     """
 
     kind: str = "indoor"
@@ -56,6 +59,7 @@ class DataConfig:
     augment: Augment = Augment()  # lipjax.data.augment; the default only crops
     focal_range: tuple[float, float] = (1.0, 1.0)
     far_view_prob: float = 0.0
+    clutter_prob: float = 0.0
 
 
 LOSS_SCALES = ("max_depth", "samples")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import math
 from typing import Iterator
 
 import numpy as np
@@ -24,7 +25,8 @@ from lipjax.data.synthetic.constants import (
     SPLITS,
     SYNTHETIC_KINDS,
 )
-from lipjax.data.synthetic.far_view import add_far_view, check_far_view_prob
+from lipjax.data.synthetic.clutter import add_clutter
+from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import Reflection, render_scene
 from lipjax.data.synthetic.scenes import build_scene
 
@@ -68,6 +70,17 @@ def check_size(height, width) -> tuple[int, int]:
     if not ints or height < 8 or width < 8:
         raise ValueError(f"height and width must be ints >= 8, got {height!r} x {width!r}")
     return int(height), int(width)
+
+
+def check_probability(name: str, p) -> float:
+    """p as a float; ValueError naming `name` unless 0 <= p <= 1."""
+    try:
+        value = float(p)
+    except (TypeError, ValueError):
+        value = math.nan
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"{name} must be a probability in [0, 1], got {p!r}")
+    return value
 
 
 def intrinsics_for(kind: str, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH) -> Intrinsics:
@@ -141,9 +154,17 @@ def far_view_rng(split: str, index: int) -> np.random.Generator:
     return np.random.default_rng(_seed(f"lipjax/synthetic/window/v1/{split}/{index}"))
 
 
+def clutter_rng(split: str, index: int) -> np.random.Generator:
+    """The stream that decides room `index` of `split`'s clutter (SyntheticDataset's clutter_prob): whether, then
+    what and where (lipjax.data.synthetic.clutter.add_clutter); sha256 of
+    "lipjax/synthetic/clutter/v1/{split}/{index}"."""
+    return np.random.default_rng(_seed(f"lipjax/synthetic/clutter/v1/{split}/{index}"))
+
+
 def render_with_info(
     kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
     focal_range: tuple[float, float] = (1.0, 1.0), reflection: Reflection | None = None,
+    clutter: np.random.Generator | None = None,
 ) -> tuple[Sample, SceneInfo]:
     """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
 
@@ -151,6 +172,8 @@ def render_with_info(
     point kept): below 1 a wider field of view, above 1 a narrower one, the same scene and pose.
     `reflection`: a polished floor or wet road (lipjax.data.synthetic.renderer.Reflection), the same scene, depth
     and sensor noise; None: matte, as every data set of this package renders its frames.
+    `clutter`: a room only; the stream that draws things on its floor (lipjax.data.synthetic.clutter.add_clutter,
+    e.g. `clutter_rng(split, index)`); None: the room as built.
 
     Raises:
       ValueError: unknown kind / split, a negative or non-integer index, or a size below 8 pixels.
@@ -160,6 +183,10 @@ def render_with_info(
     height, width = check_size(height, width)
     scene_rng, noise_rng = frame_rngs(kind, split, index)
     scene = build_scene(kind, scene_rng)
+    if clutter is not None:
+        if kind != "indoor":
+            raise ValueError(f"clutter is for rooms (kind 'indoor'), got kind {kind!r}")
+        scene = add_clutter(scene, clutter)
     intr = intrinsics_for(kind, height, width)
     f = focal_factor(kind, split, index, focal_range)
     if f != 1.0:
@@ -205,10 +232,12 @@ class SyntheticDataset:
       height, width: render size in pixels.
       focal_range: (lo, hi) factors on the reference focal length, one per frame (`focal_factor`); (1, 1): the
         reference camera (NYU v2 / KITTI).
+      clutter_prob: rooms only: the probability that room i has things on its floor (lipjax.data.synthetic.clutter),
+        decided and drawn by `clutter_rng(split, i)`; 0: rooms as built, as `render` gives them.
     """
 
     def __init__(self, kind: str, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT,
-                 width: int = DEFAULT_WIDTH, focal_range: tuple[float, float] = (1.0, 1.0)):
+                 width: int = DEFAULT_WIDTH, focal_range: tuple[float, float] = (1.0, 1.0), clutter_prob: float = 0.0):
         check_kind_split(kind, split)
         if size is None:
             size = DEFAULT_SIZES[split]
@@ -217,6 +246,9 @@ class SyntheticDataset:
         self.kind, self.split, self.size = kind, split, int(size)
         self.height, self.width = check_size(height, width)
         self.focal_range = check_focal_range(focal_range)
+        self.clutter_prob = check_probability("clutter_prob", clutter_prob)
+        if self.clutter_prob and kind != "indoor":
+            raise ValueError(f"clutter_prob is for rooms (kind 'indoor'), got kind {kind!r}; leave it at 0")
 
     def __len__(self) -> int:
         return self.size
@@ -226,7 +258,11 @@ class SyntheticDataset:
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
                                    f"of size {self.size}")
-        return render(self.kind, self.split, index, self.height, self.width, self.focal_range)
+        rng = clutter_rng(self.split, index) if self.clutter_prob else None
+        if rng is None or rng.random() >= self.clutter_prob:
+            return render(self.kind, self.split, index, self.height, self.width, self.focal_range)
+        return render_with_info(self.kind, self.split, index, self.height, self.width, self.focal_range,
+                                clutter=rng)[0]
 
     def __iter__(self) -> Iterator[Sample]:
         for i in range(self.size):
@@ -239,8 +275,9 @@ class SyntheticDataset:
 
     def __repr__(self) -> str:
         focal = "" if self.focal_range == (1.0, 1.0) else f", focal_range={self.focal_range}"
+        clutter = f", clutter_prob={self.clutter_prob}" if self.clutter_prob else ""
         return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
-                f"width={self.width}{focal})")
+                f"width={self.width}{focal}{clutter})")
 
 
 class MixedSyntheticDataset:
@@ -254,16 +291,18 @@ class MixedSyntheticDataset:
     far_view_prob: the probability that a room shows a far view through a window (lipjax.data.synthetic.far_view):
     with it, room i gets a rectangle of street frame j of the same split, j and the rectangle drawn from
     `far_view_rng(split, i)`. 0: closed rooms, as `render` gives them.
+    clutter_prob: the rooms' (SyntheticDataset's clutter_prob); streets have none.
     """
 
     kind = MIXED_SCENES
 
     def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
-                 focal_range: tuple[float, float] = (1.0, 1.0), far_view_prob: float = 0.0):
-        self.parts = tuple(SyntheticDataset(kind, split, None, height, width, focal_range) for kind in SYNTHETIC_KINDS)
+                 focal_range: tuple[float, float] = (1.0, 1.0), far_view_prob: float = 0.0, clutter_prob: float = 0.0):
+        self.parts = tuple(SyntheticDataset(kind, split, None, height, width, focal_range,
+                                            clutter_prob if kind == "indoor" else 0.0) for kind in SYNTHETIC_KINDS)
         self.split, self.height, self.width = split, *check_size(height, width)
         self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
-        self.far_view_prob = check_far_view_prob(far_view_prob)
+        self.far_view_prob = check_probability("far_view_prob", far_view_prob)
 
     def __len__(self) -> int:
         return self.size
@@ -284,5 +323,6 @@ class MixedSyntheticDataset:
     def __repr__(self) -> str:
         focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
         far_view = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
+        clutter = f", clutter_prob={self.parts[0].clutter_prob}" if self.parts[0].clutter_prob else ""
         return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
-                f"{focal}{far_view})")
+                f"{focal}{far_view}{clutter})")

@@ -27,17 +27,6 @@ WINDOW_TOP = (0.0, 0.35)  # window top edge / frame height: windows and door top
 VIEW_ROWS = 0.5  # the view is cut from the street frame's upper half
 
 
-def check_far_view_prob(far_view_prob) -> float:
-    """far_view_prob as a float; ValueError unless 0 <= far_view_prob <= 1."""
-    try:
-        p = float(far_view_prob)
-    except (TypeError, ValueError):
-        raise ValueError(f"far_view_prob must be a probability in [0, 1], got {far_view_prob!r}") from None
-    if not 0.0 <= p <= 1.0:
-        raise ValueError(f"far_view_prob must be a probability in [0, 1], got {far_view_prob!r}")
-    return p
-
-
 def far_view_box(shape: tuple[int, int], rng: np.random.Generator) -> tuple[int, int, int, int, int, int]:
     """(t, l, h, w, t', l'): the window in the room and the top-left corner of the view it shows (pixels)."""
     H, W = shape

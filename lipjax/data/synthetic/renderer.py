@@ -181,6 +181,8 @@ class Reflection:
 
 
 _MIRROR_Y = np.diag([1.0, -1.0, 1.0])  # the reflection in the plane y = 0
+_FLOOR_NORMAL_MIN_Y = 0.99  # a reflecting pixel's surface faces up (normal's y component at least this)
+_FLOOR_HEIGHT_TOL_M = 1e-2  # and lies on y = 0 (rugs and mats, a few centimetres up, do not reflect)
 
 
 def _mirror_radiance(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics, blur_px: float) -> np.ndarray:
@@ -213,7 +215,8 @@ def _mirror_radiance(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics
 def _reflect(scene: Scene, prims: list, s: _Surfaces, lin: np.ndarray, reflection: Reflection, intr: Intrinsics,
              H: int, W: int) -> None:
     """Blends the mirror image into the (3, N) `lin` on the floor and road pixels (see `Reflection`)."""
-    on_floor = (s.hit & np.isin(s.labels, (_FLOOR, _ROAD)) & (s.n[1] > 0.99) & (np.abs(s.p[1]) < 1e-2))
+    on_floor = (s.hit & np.isin(s.labels, (_FLOOR, _ROAD)) & (s.n[1] > _FLOOR_NORMAL_MIN_Y)
+                & (np.abs(s.p[1]) < _FLOOR_HEIGHT_TOL_M))
     if not on_floor.any():
         return
     dx, dy, dz = (a[on_floor] for a in s.d)
