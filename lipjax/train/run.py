@@ -54,8 +54,12 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
         trees = [manager.restore(template, step)[0].g_params for step in steps]
     finally:
         manager.close()
-    mean = jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype), *trees)
-    return mean, steps
+    return mean_params(trees), steps
+
+
+def mean_params(trees: list) -> Any:
+    """The element-wise mean of parameter trees of one structure, in each leaf's dtype."""
+    return jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype), *trees)
 
 
 def soup(config: TrainConfig, models: list[str], export: str | os.PathLike) -> dict:
@@ -82,8 +86,7 @@ def soup(config: TrainConfig, models: list[str], export: str | os.PathLike) -> d
                              "not part of the last model's); list models of one chain, the newest last")
     check_writable(pathlib.Path(export).parent, "the soup (--export)")
     model = loaded[-1][0]
-    mean = jax.tree_util.tree_map(lambda *leaves: np.mean(np.stack(leaves), axis=0).astype(leaves[0].dtype),
-                                  *(params for _, params, _ in loaded))
+    mean = mean_params([params for _, params, _ in loaded])
     val = evaluate_params(model, mean, validation_batches(config), model.max_depth_m)
     model_io.save(export, model, mean, {**loaded[-1][2], "val_metrics": val, "soup": [str(m) for m in models]})
     print(f"[lipjax] exported the soup of {', '.join(map(str, models))} to {export}: val rmse_m={val['rmse_m']:.4f}")
