@@ -77,8 +77,8 @@ scene elements, each a builder with its parameter ranges in a frozen dataclass: 
 `indoor` (room shell, decals, camera, furniture placement, ceiling lights); `street` (the layout), `road`,
 `vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
 `scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
-`render_scene`); `far_view` (windows onto streets in rooms); `dataset` (the public entry points: seeds,
-checks, `render`).
+`render_scene`, floor reflections on request: `Reflection`); `far_view` (windows onto streets in rooms); `clutter`
+(things on a room's floor, on request); `dataset` (the public entry points: seeds, checks, `render`).
 """
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,
