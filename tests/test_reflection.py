@@ -10,9 +10,8 @@ from lipjax.data.sample import Intrinsics
 from lipjax.data.synthetic.constants import _ROAD, _WALL
 from lipjax.data.synthetic.materials import _Mat
 from lipjax.data.synthetic.primitives import _Box, _Ground
-from lipjax.data.synthetic.renderer import Reflection, _reflect, _shade, _surfaces_of, render_scene
+from lipjax.data.synthetic.renderer import Reflection, _lit, _reflect, render_scene
 from lipjax.data.synthetic.scene import Scene, _camera_rotation
-from lipjax.data.synthetic.visibility import _CameraRays, _visibility
 
 H, W = 96, 64
 INTR = Intrinsics(fx=60.0, fy=60.0, cx=(W - 1) / 2, cy=(H - 1) / 2)
@@ -36,10 +35,7 @@ def _wall_scene() -> Scene:
 def _radiance(scene: Scene, reflection: Reflection | None, intr: Intrinsics = INTR, size=(H, W)):
     """((3, h, w) linear radiance of `scene` with `reflection` blended in, (h, w) labels) at `size` (h, w)."""
     h, w = size
-    rays = _CameraRays(scene, h, w, intr)
-    zbuf, ids = _visibility(scene.prims, scene, rays, intr)
-    s = _surfaces_of(scene.prims, scene, rays, zbuf, ids, intr)
-    lin = _shade(scene, s, intr, h, w)
+    _, s, lin = _lit(scene, scene.prims, h, w, intr)
     if reflection is not None:
         _reflect(scene, scene.prims, s, lin, reflection, intr, h, w)
     return lin.reshape(3, h, w), s.labels.reshape(h, w)

@@ -259,10 +259,9 @@ class SyntheticDataset:
             raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
                                    f"of size {self.size}")
         rng = clutter_rng(self.split, index) if self.clutter_prob else None
-        if rng is None or rng.random() >= self.clutter_prob:
-            return render(self.kind, self.split, index, self.height, self.width, self.focal_range)
+        clutter = rng if rng is not None and rng.random() < self.clutter_prob else None
         return render_with_info(self.kind, self.split, index, self.height, self.width, self.focal_range,
-                                clutter=rng)[0]
+                                clutter=clutter)[0]
 
     def __iter__(self) -> Iterator[Sample]:
         for i in range(self.size):

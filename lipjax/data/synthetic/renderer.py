@@ -185,6 +185,18 @@ _FLOOR_NORMAL_MIN_Y = 0.99  # a reflecting pixel's surface faces up (normal's y 
 _FLOOR_HEIGHT_TOL_M = 1e-2  # and lies on y = 0 (rugs and mats, a few centimetres up, do not reflect)
 
 
+def _lit(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics) -> tuple[np.ndarray, _Surfaces, np.ndarray]:
+    """(z-buffer (H, W), the surfaces hit, (3, H * W) linear radiance with the sky) of `prims` seen through the
+    camera of `scene`."""
+    rays = _CameraRays(scene, H, W, intr)
+    zbuf, ids = _visibility(prims, scene, rays, intr)
+    s = _surfaces_of(prims, scene, rays, zbuf, ids, intr)
+    lin = _shade(scene, s, intr, H, W)
+    if scene.sky is not None and (~s.hit).any():
+        _paint_sky(scene, lin, ~s.hit, intr, H, W)
+    return zbuf, s, lin
+
+
 def _mirror_radiance(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics, blur_px: float) -> np.ndarray:
     """(3, H * W) linear radiance that the camera mirrored in y = 0 sees, rendered at half size and upsampled.
 
@@ -197,12 +209,7 @@ def _mirror_radiance(scene: Scene, prims: list, H: int, W: int, intr: Intrinsics
     kept = [p for p in prims if not isinstance(p, _Ground)]
     h, w = (H + 1) // 2, (W + 1) // 2
     half = Intrinsics(intr.fx / 2, intr.fy / 2, intr.cx / 2, intr.cy / 2)  # pixel 2 i of the frame is pixel i
-    rays = _CameraRays(mirrored, h, w, half)
-    zbuf, ids = _visibility(kept, mirrored, rays, half)
-    s = _surfaces_of(kept, mirrored, rays, zbuf, ids, half)
-    lin = _shade(mirrored, s, half, h, w)
-    if scene.sky is not None and (~s.hit).any():
-        _paint_sky(mirrored, lin, ~s.hit, half, h, w)
+    _, _, lin = _lit(mirrored, kept, h, w, half)
     out = np.empty((3, H * W), _F32)
     for c in range(3):
         full = cv2.resize(lin[c].reshape(h, w), (W, H), interpolation=cv2.INTER_LINEAR)
@@ -235,12 +242,7 @@ def render_scene(scene: Scene, H: int, W: int, intr: Intrinsics, noise_rng,
     0 = sky))."""
     prims = _by_material(scene.prims)
     _cache_hulls(prims)
-    rays = _CameraRays(scene, H, W, intr)
-    zbuf, ids = _visibility(prims, scene, rays, intr)
-    s = _surfaces_of(prims, scene, rays, zbuf, ids, intr)
-    lin = _shade(scene, s, intr, H, W)
-    if scene.sky is not None and (~s.hit).any():
-        _paint_sky(scene, lin, ~s.hit, intr, H, W)
+    zbuf, s, lin = _lit(scene, prims, H, W, intr)
     if reflection is not None:
         _reflect(scene, prims, s, lin, reflection, intr, H, W)
     rgb = _camera_image(lin, scene, H, W, noise_rng)
