@@ -147,16 +147,21 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         size = data.val_images if split == "val" else None
         focal = (1.0, 1.0) if split == "val" else data.focal_range  # validation: the reference camera
         clutter = 0.0 if split == "val" else data.clutter_prob  # validation: the rooms as built
+        foliage = 0.0 if split == "val" else data.foliage_prob  # validation: solid trees
         if data.kind == MIXED_SCENES:
             far_view = 0.0 if split == "val" else data.far_view_prob  # validation: closed rooms
-            return MixedSyntheticDataset(split, size, data.height, data.width, focal, far_view, clutter), None
+            return MixedSyntheticDataset(split, size, data.height, data.width, focal, far_view, clutter,
+                                         foliage), None
         if data.far_view_prob:
             raise ValueError(f"data.far_view_prob needs rooms and streets (data.kind='{MIXED_SCENES}'), got "
                              f"data.kind={data.kind!r}; add --set data.kind={MIXED_SCENES} or data.far_view_prob=0")
         if data.clutter_prob and data.kind != "indoor":
             raise ValueError(f"data.clutter_prob needs rooms (data.kind='indoor' or '{MIXED_SCENES}'), got "
                              f"data.kind={data.kind!r}; leave data.clutter_prob at 0")
-        return SyntheticDataset(data.kind, split, size, data.height, data.width, focal, clutter), None
+        if data.foliage_prob and data.kind != "outdoor":
+            raise ValueError(f"data.foliage_prob needs streets (data.kind='outdoor' or '{MIXED_SCENES}'), got "
+                             f"data.kind={data.kind!r}; leave data.foliage_prob at 0")
+        return SyntheticDataset(data.kind, split, size, data.height, data.width, focal, clutter, foliage), None
     if root is None:
         raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")
     if source == "rendered":

@@ -41,6 +41,9 @@ class DataConfig:
     clutter_prob: source synthetic, rooms (kind indoor or mixed), training frames only: the probability that a room
     has things of many sizes on its floor where the camera looks (lipjax.data.synthetic.clutter). Validation keeps
     the rooms as built.
+    foliage_prob: source synthetic, streets (kind outdoor or mixed), training frames only: the probability that a
+    street's trees and bushes are porous, clumps of leaves (lipjax.data.synthetic.foliage). Validation keeps them
+    solid.
     """
 
     kind: str = "indoor"
@@ -60,6 +63,7 @@ class DataConfig:
     focal_range: tuple[float, float] = (1.0, 1.0)
     far_view_prob: float = 0.0
     clutter_prob: float = 0.0
+    foliage_prob: float = 0.0
 
 
 LOSS_SCALES = ("max_depth", "samples")

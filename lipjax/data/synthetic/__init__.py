@@ -78,7 +78,8 @@ scene elements, each a builder with its parameter ranges in a frozen dataclass: 
 `vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
 `scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
 `render_scene`, floor reflections on request: `Reflection`); `far_view` (windows onto streets in rooms); `clutter`
-(things on a room's floor, on request); `dataset` (the public entry points: seeds, checks, `render`).
+(things on a room's floor, on request); `foliage` (porous trees and bushes, on request); `dataset` (the public
+entry points: seeds, checks, `render`).
 """
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,

@@ -26,6 +26,7 @@ from lipjax.data.synthetic.constants import (
     SYNTHETIC_KINDS,
 )
 from lipjax.data.synthetic.clutter import add_clutter
+from lipjax.data.synthetic.foliage import porous_foliage
 from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import Reflection, render_scene
 from lipjax.data.synthetic.scenes import build_scene
@@ -161,10 +162,25 @@ def clutter_rng(split: str, index: int) -> np.random.Generator:
     return np.random.default_rng(_seed(f"lipjax/synthetic/clutter/v1/{split}/{index}"))
 
 
+def foliage_rng(split: str, index: int) -> np.random.Generator:
+    """The stream that decides street `index` of `split`'s porous foliage (SyntheticDataset's foliage_prob):
+    whether, then its clumps (lipjax.data.synthetic.foliage.porous_foliage); sha256 of
+    "lipjax/synthetic/foliage/v1/{split}/{index}"."""
+    return np.random.default_rng(_seed(f"lipjax/synthetic/foliage/v1/{split}/{index}"))
+
+
+def _drawn(stream, split: str, index: int, p: float) -> np.random.Generator | None:
+    """`stream(split, index)` if its first draw says frame `index` gets the extra (probability p), else None."""
+    if not p:
+        return None
+    rng = stream(split, index)
+    return rng if rng.random() < p else None
+
+
 def render_with_info(
     kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
     focal_range: tuple[float, float] = (1.0, 1.0), reflection: Reflection | None = None,
-    clutter: np.random.Generator | None = None,
+    clutter: np.random.Generator | None = None, foliage: np.random.Generator | None = None,
 ) -> tuple[Sample, SceneInfo]:
     """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
 
@@ -187,6 +203,10 @@ def render_with_info(
         if kind != "indoor":
             raise ValueError(f"clutter is for rooms (kind 'indoor'), got kind {kind!r}")
         scene = add_clutter(scene, clutter)
+    if foliage is not None:
+        if kind != "outdoor":
+            raise ValueError(f"porous foliage is for streets (kind 'outdoor'), got kind {kind!r}")
+        scene = porous_foliage(scene, foliage)
     intr = intrinsics_for(kind, height, width)
     f = focal_factor(kind, split, index, focal_range)
     if f != 1.0:
@@ -234,10 +254,13 @@ class SyntheticDataset:
         reference camera (NYU v2 / KITTI).
       clutter_prob: rooms only: the probability that room i has things on its floor (lipjax.data.synthetic.clutter),
         decided and drawn by `clutter_rng(split, i)`; 0: rooms as built, as `render` gives them.
+      foliage_prob: streets only: the probability that street i's trees and bushes are porous
+        (lipjax.data.synthetic.foliage), decided and drawn by `foliage_rng(split, i)`; 0: solid, as `render` gives.
     """
 
     def __init__(self, kind: str, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT,
-                 width: int = DEFAULT_WIDTH, focal_range: tuple[float, float] = (1.0, 1.0), clutter_prob: float = 0.0):
+                 width: int = DEFAULT_WIDTH, focal_range: tuple[float, float] = (1.0, 1.0), clutter_prob: float = 0.0,
+                 foliage_prob: float = 0.0):
         check_kind_split(kind, split)
         if size is None:
             size = DEFAULT_SIZES[split]
@@ -249,6 +272,9 @@ class SyntheticDataset:
         self.clutter_prob = check_probability("clutter_prob", clutter_prob)
         if self.clutter_prob and kind != "indoor":
             raise ValueError(f"clutter_prob is for rooms (kind 'indoor'), got kind {kind!r}; leave it at 0")
+        self.foliage_prob = check_probability("foliage_prob", foliage_prob)
+        if self.foliage_prob and kind != "outdoor":
+            raise ValueError(f"foliage_prob is for streets (kind 'outdoor'), got kind {kind!r}; leave it at 0")
 
     def __len__(self) -> int:
         return self.size
@@ -258,10 +284,9 @@ class SyntheticDataset:
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
                                    f"of size {self.size}")
-        rng = clutter_rng(self.split, index) if self.clutter_prob else None
-        clutter = rng if rng is not None and rng.random() < self.clutter_prob else None
         return render_with_info(self.kind, self.split, index, self.height, self.width, self.focal_range,
-                                clutter=clutter)[0]
+                                clutter=_drawn(clutter_rng, self.split, index, self.clutter_prob),
+                                foliage=_drawn(foliage_rng, self.split, index, self.foliage_prob))[0]
 
     def __iter__(self) -> Iterator[Sample]:
         for i in range(self.size):
@@ -274,9 +299,9 @@ class SyntheticDataset:
 
     def __repr__(self) -> str:
         focal = "" if self.focal_range == (1.0, 1.0) else f", focal_range={self.focal_range}"
-        clutter = f", clutter_prob={self.clutter_prob}" if self.clutter_prob else ""
+        extra = "".join(f", {k}={getattr(self, k)}" for k in ("clutter_prob", "foliage_prob") if getattr(self, k))
         return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
-                f"width={self.width}{focal}{clutter})")
+                f"width={self.width}{focal}{extra})")
 
 
 class MixedSyntheticDataset:
@@ -290,15 +315,16 @@ class MixedSyntheticDataset:
     far_view_prob: the probability that a room shows a far view through a window (lipjax.data.synthetic.far_view):
     with it, room i gets a rectangle of street frame j of the same split, j and the rectangle drawn from
     `far_view_rng(split, i)`. 0: closed rooms, as `render` gives them.
-    clutter_prob: the rooms' (SyntheticDataset's clutter_prob); streets have none.
+    clutter_prob: the rooms' (SyntheticDataset's clutter_prob); foliage_prob: the streets' (SyntheticDataset's).
     """
 
     kind = MIXED_SCENES
 
     def __init__(self, split: str, size: int | None = None, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
-                 focal_range: tuple[float, float] = (1.0, 1.0), far_view_prob: float = 0.0, clutter_prob: float = 0.0):
-        self.parts = tuple(SyntheticDataset(kind, split, None, height, width, focal_range,
-                                            clutter_prob if kind == "indoor" else 0.0) for kind in SYNTHETIC_KINDS)
+                 focal_range: tuple[float, float] = (1.0, 1.0), far_view_prob: float = 0.0, clutter_prob: float = 0.0,
+                 foliage_prob: float = 0.0):
+        self.parts = (SyntheticDataset("indoor", split, None, height, width, focal_range, clutter_prob=clutter_prob),
+                      SyntheticDataset("outdoor", split, None, height, width, focal_range, foliage_prob=foliage_prob))
         self.split, self.height, self.width = split, *check_size(height, width)
         self.size = 2 * min(len(p) for p in self.parts) if size is None else int(size)
         self.far_view_prob = check_probability("far_view_prob", far_view_prob)
@@ -323,5 +349,6 @@ class MixedSyntheticDataset:
         focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
         far_view = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
         clutter = f", clutter_prob={self.parts[0].clutter_prob}" if self.parts[0].clutter_prob else ""
+        foliage = f", foliage_prob={self.parts[1].foliage_prob}" if self.parts[1].foliage_prob else ""
         return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
-                f"{focal}{far_view}{clutter})")
+                f"{focal}{far_view}{clutter}{foliage})")

@@ -4,10 +4,11 @@ The rendered crowns and bushes are a few smooth spheres each: solid blobs whose 
 foliage is porous: a LiDAR scan or an accumulated depth map of a tree holds returns from the near leaves, the far
 side of the crown, the trunk and whatever stands behind, side by side (KITTI's streets are lined with trees).
 `porous_foliage(scene, rng)` replaces each foliage sphere of radius R (label _VEGETATION, R >= `min_radius_m`) by
-n clumps of radius a R, their centres uniform in the ball of radius (1 - a) R, so that the crown keeps its outline
-and its size; with n a^2 ~ 1-3 a ray through the crown meets a clump with probability ~ 1 - exp(-n a^2 4/3 ...),
-leaving gaps. Draws come from `rng` alone, after the scene is built: the same street, its trees see-through.
-Units: metres.
+n clumps of radius at most a R, their centres uniform in the ball of radius (1 - a) R: every clump lies inside the
+sphere, so the crown keeps its outline and nothing comes nearer than the solid crown was. A ray through the crown's
+middle meets on average about (3/2) n (r / ((1 - a) R))^2 clumps of radius r (0.3 to 14 over the ranges) and, with
+probability about exp of minus that, none: sky, trunk or street behind. Draws come from `rng` alone, after the
+scene is built: the same street, its trees see-through. Units: metres.
 """
 from __future__ import annotations
 
@@ -39,7 +40,7 @@ def _clumps(rng, centre: np.ndarray, radius: float, r: FoliageRanges) -> tuple[n
     d = rng.normal(size=(n, 3))
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     reach = (1.0 - a) * radius * rng.random(n) ** (1.0 / 3.0)  # uniform in the ball
-    radii = a * radius * rng.uniform(0.7, 1.3, n)
+    radii = a * radius * rng.uniform(0.6, 1.0, n)  # inside the sphere
     return centre + reach[:, None] * d, radii
 
 
