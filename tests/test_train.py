@@ -19,7 +19,7 @@ from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 from lipjax.train import loop
 from lipjax.train.checkpoint import CheckpointManager
-from lipjax.train.config import DataConfig, TrainConfig
+from lipjax.train.config import DataConfig, TrainConfig, data_recipe
 from lipjax.train.state import init_state
 
 from helpers import alive, children
@@ -415,8 +415,9 @@ def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_
 
 
 def test_a_warm_start_records_its_data_and_warns_when_it_would_read_the_same_again(straight_run, tmp_path):
-    """Step s of a run reads what its config and seed give step s: a model records each run of its chain of warm
-    starts, and a run from it with a config and seed already in that chain warns (it repeats those frames)."""
+    """Step s of a run reads what its config, data settings and seed give step s: a model records each run of its
+    chain of warm starts (--set data overrides included), and a run from it with a config and seed already in that
+    chain warns (it repeats those frames)."""
     import warnings
 
     def first_frames(seed):
@@ -426,18 +427,21 @@ def test_a_warm_start_records_its_data_and_warns_when_it_would_read_the_same_aga
     _, state = straight_run
     loop.export(CONFIG, state, tmp_path / "first")
     steps = CONFIG.total_steps
+    recipe = data_recipe(CONFIG.data)
+    assert recipe and "root" not in recipe and recipe == json.loads(json.dumps(recipe))  # JSON as recorded
     assert loop.data_streams(lipjax.load_model(tmp_path / "first").metadata) == [
-        {"train_config": "test", "seed": 0, "steps": steps}]
+        {"train_config": "test", "seed": 0, "steps": steps, "data": recipe}]
     again = dataclasses.replace(CONFIG, init_from=str(tmp_path / "first"))
     with pytest.warns(UserWarning, match="seed 0: this run reads the same frames.*--set seed=N"):
         loop._initial_g_params(again)
-    fresh = dataclasses.replace(again, seed=7)
+    fresh = dataclasses.replace(again, seed=7, data=dataclasses.replace(CONFIG.data, clutter_prob=0.5))
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         loop._initial_g_params(fresh)  # a seed of its own: no warning
     loop.export(fresh, state, tmp_path / "second")
     assert loop.data_streams(lipjax.load_model(tmp_path / "second").metadata) == [
-        {"train_config": "test", "seed": 0, "steps": steps}, {"train_config": "test", "seed": 7, "steps": steps}]
+        {"train_config": "test", "seed": 0, "steps": steps, "data": recipe},
+        {"train_config": "test", "seed": 7, "steps": steps, "data": {**recipe, "clutter_prob": 0.5}}]  # as --set
     with pytest.warns(UserWarning, match="seed 0"):  # the first run's stream is still in the chain
         loop._initial_g_params(dataclasses.replace(CONFIG, init_from=str(tmp_path / "second")))
     # a model saved before the streams were recorded read its config's with the default seed

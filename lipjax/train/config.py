@@ -123,6 +123,27 @@ class TrainConfig:
         return self.d_steps + self.adv_steps > 0
 
 
+# DataConfig fields that do not change which frames, samples and crops a run reads (where, and how fast).
+NOT_RECIPE = ("root", "raw_root", "num_workers", "val_sampler", "val_images")
+
+
+def data_recipe(data: DataConfig) -> dict:
+    """The fields of `data` that differ from DataConfig()'s (an Augment's from Augment()'s, nested), as JSON
+    values, leaving out NOT_RECIPE: with a run's config name and seed they fix the frames, samples and crops it
+    reads, --set overrides included (lipjax.train.loop.data_streams)."""
+    def diff(obj, default, skip=()) -> dict:
+        out = {}
+        for f in dataclasses.fields(obj):
+            value, base = getattr(obj, f.name), getattr(default, f.name)
+            if f.name in skip or value == base:
+                continue
+            out[f.name] = diff(value, base) if dataclasses.is_dataclass(value) else (
+                list(value) if isinstance(value, tuple) else value)
+        return out
+
+    return diff(data, DataConfig(), NOT_RECIPE)
+
+
 def parse_overrides(items: list[str]) -> dict[str, str]:
     """["a.b=1", ...] (the --set arguments) -> {"a.b": "1"}; one-line ValueError for an item without '=' or a field."""
     overrides = {}

@@ -35,7 +35,7 @@ from lipjax.data.sample import Batch
 from lipjax.data.sources import open_source
 from lipjax.inference import compiled_apply
 from lipjax.metrics import MetricAggregator, compute_metrics
-from lipjax.train.config import TrainConfig
+from lipjax.train.config import TrainConfig, data_recipe
 from lipjax.train.state import TrainState, init_state  # noqa: F401  (re-exported)
 from lipjax.train.steps import make_steps
 
@@ -274,10 +274,13 @@ def train(
 
 
 def data_streams(metadata: dict) -> list[dict]:
-    """The training data a saved model has read, oldest run first: one {"train_config", "seed", "steps"} per run of
-    its chain of warm starts (`init_from`); step s of a run reads the frames, samples and crops that its config
-    and seed give step s, so two runs of one config and seed read the same data. A model saved before these were
-    recorded gives its last run's config with the default seed 0 (every run before then used it), steps unknown."""
+    """The training data a saved model has read, oldest run first: one {"train_config", "seed", "steps", "data"} per
+    run of its chain of warm starts (`init_from`); step s of a run reads the frames, samples and crops that its
+    config, its data settings ("data": lipjax.train.config.data_recipe, --set overrides included) and its seed give
+    step s, so two runs with the same three read the same data. Runs saved before "data" was recorded (2026-12-03)
+    have none: their data settings are their config's (--set overrides, if any, are in their workdir's
+    config.txt). A model saved before the streams were recorded gives its last run's config with the default seed
+    0 (every run before then used it), steps unknown."""
     if "data_streams" in metadata:
         return list(metadata["data_streams"])
     if "train_config" in metadata:
@@ -296,6 +299,6 @@ def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
     meta = {"train_config": config.name, "steps": int(state.step),
             "images_seen": init_meta.get("images_seen", 0) + int(state.step) * config.batch_size,
             "data_streams": data_streams(init_meta) + [{"train_config": config.name, "seed": config.seed,
-                                                        "steps": int(state.step)}],
+                                                        "steps": int(state.step), "data": data_recipe(config.data)}],
             "train_sampler": config.data.train_sampler, **(metadata or {})}
     model_io.save(path, config.model, params, meta)
