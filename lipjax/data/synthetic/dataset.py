@@ -315,7 +315,8 @@ class MixedSyntheticDataset:
     far_view_prob: the probability that a room shows a far view through a window (lipjax.data.synthetic.far_view):
     with it, room i gets a rectangle of street frame j of the same split, j and the rectangle drawn from
     `far_view_rng(split, i)`. 0: closed rooms, as `render` gives them.
-    clutter_prob: the rooms' (SyntheticDataset's clutter_prob); foliage_prob: the streets' (SyntheticDataset's).
+    clutter_prob: the rooms' (SyntheticDataset's clutter_prob); foliage_prob: the streets' (SyntheticDataset's),
+    and so also those of the far views.
     """
 
     kind = MIXED_SCENES

@@ -52,14 +52,10 @@ def porous_foliage(scene: Scene, rng: np.random.Generator, ranges: FoliageRanges
         if not (isinstance(p, _Spheres) and np.all(p.label == _VEGETATION)) or not (p.rs >= ranges.min_radius_m).any():
             prims.append(p)
             continue
-        cs, rs = [], []
-        for c, radius in zip(p.cs.astype(np.float64), p.rs.astype(np.float64)):
-            if radius < ranges.min_radius_m:
-                cs.append(c[None]), rs.append(np.array([radius]))
-            else:
-                c2, r2 = _clumps(rng, c, radius, ranges)
-                cs.append(c2), rs.append(r2)
-        q = _Spheres(np.concatenate(cs), np.concatenate(rs), p.label, p.mat, cast=p.cast)
+        pieces = [_clumps(rng, c, radius, ranges) if radius >= ranges.min_radius_m else (c[None], np.array([radius]))
+                  for c, radius in zip(p.cs.astype(np.float64), p.rs.astype(np.float64))]
+        q = _Spheres(np.concatenate([c for c, _ in pieces]), np.concatenate([r for _, r in pieces]), p.label, p.mat,
+                     cast=p.cast)
         q.asm = p.asm
         prims.append(q)
     return dataclasses.replace(scene, prims=prims)
