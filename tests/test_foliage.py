@@ -91,3 +91,17 @@ def test_the_dataset_makes_a_share_of_its_streets_porous_decided_per_frame_and_v
     for bad in (-0.1, 1.5, "x"):
         with pytest.raises(ValueError, match="foliage_prob must be a probability"):
             S.SyntheticDataset("outdoor", "train", size=2, height=H, width=W, foliage_prob=bad)
+
+
+def test_a_porous_crown_casts_the_same_shadow_one_clump_at_a_time(monkeypatch):
+    """shadows._split: a large sphere cluster casts as one caster per sphere (for speed); every pixel as when the
+    whole crown is one caster."""
+    from lipjax.data.synthetic import shadows
+
+    index = _leafy(1)[0]
+    split = S.render_with_info("outdoor", "train", index, H, W, foliage=foliage_rng("train", index))[0]
+    assert shadows.SPLIT_SPHERES < FOLIAGE.clumps[0]  # a porous crown's blob is split
+    monkeypatch.setattr(shadows, "SPLIT_SPHERES", 10**9)
+    whole = S.render_with_info("outdoor", "train", index, H, W, foliage=foliage_rng("train", index))[0]
+    np.testing.assert_array_equal(split.rgb, whole.rgb)
+    np.testing.assert_array_equal(split.depth, whole.depth)

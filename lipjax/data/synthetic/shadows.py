@@ -7,7 +7,7 @@ from lipjax.data.synthetic.arrays import _ranges
 from lipjax.data.synthetic.constants import _F32
 from lipjax.data.synthetic.culling import _rects
 from lipjax.data.synthetic.geometry import _shadow_t
-from lipjax.data.synthetic.primitives import _BOX_CORNERS
+from lipjax.data.synthetic.primitives import _BOX_CORNERS, _Spheres
 from lipjax.data.synthetic.scene import Light, Scene
 
 
@@ -23,10 +23,47 @@ def _f32_below(x: np.ndarray) -> np.ndarray:
     return np.where(y > x, np.nextafter(y, _F32(-np.inf)), y)
 
 
+# A sphere cluster of more spheres than this (a porous crown's clumps, lipjax.data.synthetic.foliage) casts as one
+# caster per sphere: each sphere's own shadow volume holds far fewer receivers than the whole crown's.
+SPLIT_SPHERES = 8
+
+
+class _SphereCaster:
+    """One sphere of a large cluster as a caster of its own: the cluster's shadow job for that sphere."""
+
+    def __init__(self, job: tuple):
+        self.job = job
+
+    def shadow_jobs(self) -> list:
+        return [self.job]
+
+
+def _split(group: list) -> list[tuple[list, np.ndarray]]:
+    """[(caster, its world AABB corners (8, 3))] for one assembly: itself, or, where it holds a cluster of more than
+    SPLIT_SPHERES spheres, its other members together and each of those spheres alone (the same shadow rays, the
+    same hits: a receiver outside a sphere's shadow volume cannot be blocked by it)."""
+    big = [p for p in group if _big(p)]
+    rest = [p for p in group if not _big(p)]
+    out = [(rest, _aabb(np.stack([p.hull() for p in rest])))] if rest else []
+    for p in big:
+        out += [([_SphereCaster(job)], part.hull()) for job, part in zip(p.shadow_jobs(), p.parts())]
+    return out
+
+
+def _big(p) -> bool:
+    return isinstance(p, _Spheres) and len(p.rs) > SPLIT_SPHERES
+
+
+def _aabb(hulls: np.ndarray) -> np.ndarray:
+    """(8, 3) corners of the world AABB of (P, 8, 3) hull points."""
+    lo, hi = hulls.min((0, 1)), hulls.max((0, 1))
+    return 0.5 * (lo + hi) + _BOX_CORNERS * (0.5 * (hi - lo))
+
+
 def _casters(scene: Scene) -> tuple[list, np.ndarray] | None:
     """(casters, their world AABB corners (C, 8, 3)): one caster per assembly (a car, a tree, a piece of furniture),
-    those wholly farther than scene.shadow_range from the camera left out (their shadow would be a few pixels);
-    None without any."""
+    those wholly farther than scene.shadow_range from the camera left out (their shadow would be a few pixels),
+    large sphere clusters split into their spheres (`_split`); None without any."""
     members: dict[int, list] = {}
     for p in scene.prims:
         if p.cast and not p.infinite:
@@ -44,7 +81,12 @@ def _casters(scene: Scene) -> tuple[list, np.ndarray] | None:
         return None
     casters = [g for g, k in zip(groups, keep.tolist()) if k]
     lo, hi = lo[keep], hi[keep]
-    return casters, 0.5 * (lo + hi)[:, None, :] + _BOX_CORNERS[None] * (0.5 * (hi - lo))[:, None, :]
+    hulls = 0.5 * (lo + hi)[:, None, :] + _BOX_CORNERS[None] * (0.5 * (hi - lo))[:, None, :]
+    split = [any(_big(p) for p in g) for g in casters]
+    if not any(split):
+        return casters, hulls
+    pieces = [piece for g, h, s in zip(casters, hulls, split) for piece in (_split(g) if s else [(g, h)])]
+    return [c for c, _ in pieces], np.stack([h for _, h in pieces])
 
 
 def _sun_culling(light: Light, hulls: np.ndarray, recv, px, py, pz):
