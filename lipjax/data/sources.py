@@ -142,7 +142,7 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
     source, root = data.source, data.root
     if source == "synthetic":
-        from lipjax.data.synthetic.dataset import MixedSyntheticDataset, SyntheticDataset
+        from lipjax.data.synthetic.dataset import EXTRAS, MixedSyntheticDataset, SyntheticDataset
 
         size = data.val_images if split == "val" else None
         focal = (1.0, 1.0) if split == "val" else data.focal_range  # validation: the reference camera
@@ -155,12 +155,10 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
         if data.far_view_prob:
             raise ValueError(f"data.far_view_prob needs rooms and streets (data.kind='{MIXED_SCENES}'), got "
                              f"data.kind={data.kind!r}; add --set data.kind={MIXED_SCENES} or data.far_view_prob=0")
-        if data.clutter_prob and data.kind != "indoor":
-            raise ValueError(f"data.clutter_prob needs rooms (data.kind='indoor' or '{MIXED_SCENES}'), got "
-                             f"data.kind={data.kind!r}; leave data.clutter_prob at 0")
-        if data.foliage_prob and data.kind != "outdoor":
-            raise ValueError(f"data.foliage_prob needs streets (data.kind='outdoor' or '{MIXED_SCENES}'), got "
-                             f"data.kind={data.kind!r}; leave data.foliage_prob at 0")
+        for name, (wanted, scenes) in EXTRAS.items():
+            if getattr(data, name) and data.kind != wanted:
+                raise ValueError(f"data.{name} needs {scenes} (data.kind='{wanted}' or '{MIXED_SCENES}'), got "
+                                 f"data.kind={data.kind!r}; leave data.{name} at 0")
         return SyntheticDataset(data.kind, split, size, data.height, data.width, focal, clutter, foliage), None
     if root is None:
         raise ValueError(f"data.source={source!r} needs data.root; add --set data.root=DIR")

@@ -84,6 +84,21 @@ def check_probability(name: str, p) -> float:
     return value
 
 
+# What a frame of one kind may get on request, with a probability per frame (SyntheticDataset): the probability's
+# name -> (the kind whose frames take it, what they are called).
+EXTRAS = {"clutter_prob": ("indoor", "rooms"), "foliage_prob": ("outdoor", "streets")}
+
+
+def check_extra(name: str, p, kind: str) -> float:
+    """`p` as a probability (check_probability) of extra `name` (EXTRAS) for frames of `kind`; ValueError if p > 0
+    and only frames of another kind take it."""
+    value = check_probability(name, p)
+    wanted, scenes = EXTRAS[name]
+    if value and kind != wanted:
+        raise ValueError(f"{name} is for {scenes} (kind '{wanted}'), got kind {kind!r}; leave it at 0")
+    return value
+
+
 def intrinsics_for(kind: str, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH) -> Intrinsics:
     """The camera of `kind` ("indoor": NYU v2 `NYU_INTRINSICS`, "outdoor": KITTI `KITTI_INTRINSICS`) scaled
     to height x width pixels, keeping square pixels.
@@ -269,12 +284,8 @@ class SyntheticDataset:
         self.kind, self.split, self.size = kind, split, int(size)
         self.height, self.width = check_size(height, width)
         self.focal_range = check_focal_range(focal_range)
-        self.clutter_prob = check_probability("clutter_prob", clutter_prob)
-        if self.clutter_prob and kind != "indoor":
-            raise ValueError(f"clutter_prob is for rooms (kind 'indoor'), got kind {kind!r}; leave it at 0")
-        self.foliage_prob = check_probability("foliage_prob", foliage_prob)
-        if self.foliage_prob and kind != "outdoor":
-            raise ValueError(f"foliage_prob is for streets (kind 'outdoor'), got kind {kind!r}; leave it at 0")
+        self.clutter_prob = check_extra("clutter_prob", clutter_prob, kind)
+        self.foliage_prob = check_extra("foliage_prob", foliage_prob, kind)
 
     def __len__(self) -> int:
         return self.size
@@ -299,7 +310,7 @@ class SyntheticDataset:
 
     def __repr__(self) -> str:
         focal = "" if self.focal_range == (1.0, 1.0) else f", focal_range={self.focal_range}"
-        extra = "".join(f", {k}={getattr(self, k)}" for k in ("clutter_prob", "foliage_prob") if getattr(self, k))
+        extra = "".join(f", {k}={getattr(self, k)}" for k in EXTRAS if getattr(self, k))
         return (f"SyntheticDataset({self.kind!r}, {self.split!r}, size={self.size}, height={self.height}, "
                 f"width={self.width}{focal}{extra})")
 
@@ -349,7 +360,6 @@ class MixedSyntheticDataset:
     def __repr__(self) -> str:
         focal = "" if self.parts[0].focal_range == (1.0, 1.0) else f", focal_range={self.parts[0].focal_range}"
         far_view = f", far_view_prob={self.far_view_prob}" if self.far_view_prob else ""
-        clutter = f", clutter_prob={self.parts[0].clutter_prob}" if self.parts[0].clutter_prob else ""
-        foliage = f", foliage_prob={self.parts[1].foliage_prob}" if self.parts[1].foliage_prob else ""
+        extra = "".join(f", {k}={getattr(p, k)}" for p in self.parts for k in EXTRAS if getattr(p, k))
         return (f"MixedSyntheticDataset({self.split!r}, size={self.size}, height={self.height}, width={self.width}"
-                f"{focal}{far_view}{clutter}{foliage})")
+                f"{focal}{far_view}{extra})")
