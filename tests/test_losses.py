@@ -12,6 +12,7 @@ from lipjax.priors.network import network_preset
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 from lipjax.train.losses import (
+    LOG_RMSE_EPS,
     depth_loss,
     discriminator_loss,
     generator_adversarial_loss,
@@ -31,8 +32,43 @@ def test_masked_losses_by_hand():
     assert float(depth_loss(pred, gt, valid, kind="l1")) == pytest.approx((1 + 0 + 2) / 3)
     assert float(depth_loss(pred, gt, valid, kind="l2", scale_m=2.0)) == pytest.approx((1 + 0 + 4) / 3 / 4)
     assert float(masked_mean(pred, jnp.zeros_like(valid))) == 0.0
-    with pytest.raises(ValueError, match="'l2' or 'l1'"):
+    with pytest.raises(ValueError, match="loss kind must be one of"):
         depth_loss(pred, gt, valid, kind="huber")
+
+
+def test_log_rmse_is_the_mean_log_of_each_images_rmse():
+    """kind="log_rmse": (1/B) sum_b log(RMSE_b + eps), each image's RMSE over its own valid pixels, so that the
+    loss is, up to a constant, the log of the suites' geometric-mean RMSE ratio to a fixed reference."""
+    gt = jnp.array([[[2.0, 2.0], [1.0, 0.0]], [[5.0, 5.0], [5.0, 5.0]]])
+    valid = gt > 0
+    pred = gt + jnp.array([[[-1.0, 0.0], [2.0, 7.0]], [[3.0, 3.0], [-3.0, 3.0]]])  # 7.0 on an invalid pixel
+    rmse = np.array([math.sqrt((1 + 0 + 4) / 3), 3.0])
+    expected = np.mean(np.log(rmse + LOG_RMSE_EPS))
+    assert float(depth_loss(pred, gt, valid, kind="log_rmse")) == pytest.approx(expected, rel=1e-6)
+    # units cancel but for eps: dividing by a scale s shifts the loss by -log s
+    s = jnp.array([2.0, 4.0]).reshape(2, 1, 1)
+    shifted = np.mean(np.log(rmse / np.array([2.0, 4.0]) + LOG_RMSE_EPS))
+    assert float(depth_loss(pred, gt, valid, kind="log_rmse", scale_m=s)) == pytest.approx(shifted, rel=1e-6)
+    # each image weighs alike: doubling one image's errors adds log(2) / B whatever their size
+    doubled = gt + 2 * (pred - gt) * jnp.array([1.0, 0.0]).reshape(2, 1, 1) + (pred - gt) * jnp.array(
+        [0.0, 1.0]).reshape(2, 1, 1)
+    step = float(depth_loss(doubled, gt, valid, kind="log_rmse")) - float(depth_loss(pred, gt, valid, kind="log_rmse"))
+    assert step == pytest.approx(math.log((2 * rmse[0] + LOG_RMSE_EPS) / (rmse[0] + LOG_RMSE_EPS)) / 2, rel=1e-5)
+
+
+def test_log_rmse_gradient_in_closed_form_and_finite_at_zero_error():
+    """d/dpred_i of log(RMSE + eps) = e_i / (N RMSE (RMSE + eps)) on valid pixels, 0 elsewhere (then / B); an
+    image estimated exactly, or without valid pixels, has a finite loss and no gradient."""
+    gt = jnp.array([[[1.0, 2.0, 3.0, 0.0]], [[1.0, 1.0, 1.0, 1.0]], [[0.0, 0.0, 0.0, 0.0]]])
+    valid = gt > 0
+    e = jnp.array([[[0.5, -1.0, 2.0, 9.0]], [[0.0, 0.0, 0.0, 0.0]], [[1.0, 1.0, 1.0, 1.0]]])
+    grad = np.asarray(jax.grad(lambda p: depth_loss(p, gt, valid, kind="log_rmse"))(gt + e))
+    r = math.sqrt((0.25 + 1 + 4) / 3)
+    np.testing.assert_allclose(grad[0, 0], np.array([0.5, -1.0, 2.0, 0.0]) / (3 * r * (r + LOG_RMSE_EPS)) / 3,
+                               rtol=1e-5)
+    assert np.all(grad[1:] == 0)
+    value = float(depth_loss(gt + e, gt, valid, kind="log_rmse"))
+    assert value == pytest.approx((math.log(r + LOG_RMSE_EPS) + 2 * math.log(LOG_RMSE_EPS)) / 3, rel=1e-6)
 
 
 def test_loss_in_units_of_each_images_sample_scale():
@@ -49,6 +85,8 @@ def test_loss_in_units_of_each_images_sample_scale():
     assert float(depth_loss(pred, gt, gt > 0, scale_m=10.0)) == pytest.approx((0.04 + 4.0) / 2 / 100, rel=1e-5)
     with pytest.raises(ValueError, match="loss_scale must be one of"):
         TrainConfig(name="x", model=LIPConfig(prior=network_preset("tiny")), loss_scale="median")
+    with pytest.raises(ValueError, match="loss must be one of"):
+        TrainConfig(name="x", model=LIPConfig(prior=network_preset("tiny")), loss="huber")
 
 
 def test_deep_supervision_adds_weighted_iterate_losses():

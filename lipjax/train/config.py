@@ -16,6 +16,7 @@ from lipjax.data.augment import Augment
 from lipjax.data.sampling import DEFAULT_SAMPLER
 from lipjax.interfaces import LearnedModel
 from lipjax.train.discriminator import Discriminator
+from lipjax.train.losses import LOSS_KINDS
 
 
 @dataclasses.dataclass(frozen=True)
@@ -86,7 +87,7 @@ class TrainConfig:
     warmup_steps: int = 100
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
-    loss: str = "l2"  # "l2" or "l1" (lipjax.train.losses); the shipped models' configs (experiments/configs/) set "l1"
+    loss: str = "l2"  # lipjax.train.losses.LOSS_KINDS ("l2", "l1", "log_rmse"); experiments/configs/ set "l1"
     loss_scale: str = "max_depth"  # depth errors in units of: the model's max depth, or "samples" (see __post_init__)
     inverse_depth_weight: float = 0.0  # weight of lipjax.train.losses.inverse_depth_loss (1/m) added to the depth loss
     inverse_depth_floor_m: float = 1.0
@@ -105,6 +106,8 @@ class TrainConfig:
         # at 3 m and streets at 20 m weigh alike when one model trains on both.
         if self.loss_scale not in LOSS_SCALES:
             raise ValueError(f"loss_scale must be one of {LOSS_SCALES}, got {self.loss_scale!r}")
+        if self.loss not in LOSS_KINDS:
+            raise ValueError(f"loss must be one of {LOSS_KINDS}, got {self.loss!r}")
 
     @property
     def total_steps(self) -> int:
