@@ -1,5 +1,7 @@
 """The jitted train steps (lipjax.train.steps): each loss term the config names reaches the loss, and the update is
 AdamW's closed form."""
+import dataclasses
+
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -8,7 +10,7 @@ from lipjax.model import LIPConfig
 from lipjax.priors.guided import sample_scale
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
-from lipjax.train.losses import depth_loss, inverse_depth_loss
+from lipjax.train.losses import LOG_RMSE_EPS, depth_loss, inverse_depth_loss
 from lipjax.train.state import init_state
 from lipjax.train.steps import make_steps
 
@@ -78,3 +80,19 @@ def test_supervised_step_loss_is_every_configured_term_and_its_update_is_adamw()
         clear = np.abs(c) > 1e-5  # where c / (|c| + eps) is not at the mercy of float32 rounding in c
         np.testing.assert_allclose(new[clear], expected[clear], rtol=0, atol=LR * 1e-3)
         np.testing.assert_allclose(new, expected, rtol=0, atol=2.1 * LR)  # |c / (|c| + eps)| <= 1 everywhere
+
+
+def test_the_log_rmse_loss_reaches_the_step_per_image_in_units_of_its_sample_scale():
+    """loss="log_rmse": the step's loss is (1/B) sum_b log(RMSE_b / s_b + eps), RMSE_b over image b's valid pixels
+    and s_b its sample scale, written out here in numpy from the model's output."""
+    config = dataclasses.replace(CONFIG, loss="log_rmse", iteration_weights=(), inverse_depth_weight=0.0)
+    batch = _batch(seed=3)
+    state = init_state(config, _perturbed(config.model.init(jax.random.key(0))))
+    out = np.asarray(config.model.apply(state.g_params, batch["rgb"], batch["sparse"])[0], np.float64)
+    expected = []
+    for b in range(2):
+        v = batch["gt_valid"][b]
+        s = np.exp(np.mean(np.log(batch["sparse"][b][batch["sparse"][b] > 0])))
+        expected.append(np.log(np.sqrt(np.mean((out[b][v] - batch["gt"][b][v]) ** 2)) / s + LOG_RMSE_EPS))
+    _, metrics = make_steps(config).supervised(state, batch, jax.random.key(0))
+    np.testing.assert_allclose(float(metrics["loss"]), np.mean(expected), rtol=1e-5)
