@@ -99,8 +99,8 @@ EXPECTED: dict[str, Expected] = {
              "604,000, 628,000 images, the last three with --set data.clutter_prob=0.5 and the last also with --set "
              "data.foliage_prob=0.5; each picked by validation among its last checkpoint, the mean of its last 4 "
              "and their soup with the run before's pick (--soup); the last, the soup of the thirtieth's and the "
-             "mean of the thirty-first's last 4 (628,000 images, shipped until 2026-12-04); then two more such runs with "
-             "seeds 32 and 33 (652,000, 676,000), and the thirty-fourth with --set loss=log_rmse (this config's loss "
-             "since; L1 before) from the thirty-third's soup: 700,000 images, the soup of the two, shipped by the rule"
-             " of docs/training.md (its runs 27-34)"),
+             "mean of the thirty-first's last 4 (628,000 images, shipped until 2026-12-04); then two more such "
+             "runs with seeds 32 and 33 (652,000, 676,000), and the thirty-fourth with --set loss=log_rmse (this "
+             "config's loss since; L1 before) from the thirty-third's soup: 700,000 images, the soup of the two, "
+             "shipped by the rule of docs/training.md (its runs 27-34)"),
 }
