@@ -21,7 +21,7 @@ def plot_curves(metrics_path: str | os.PathLike, out_path: str | os.PathLike, ti
         pts = [(r["step"], r["loss"]) for r in train_rows if r["phase"] == phase]
         if pts:
             ax0.plot(*zip(*pts), label=phase)
-    ax0.set_yscale("log")
+    ax0.set_yscale(loss_axis_scale([r["loss"] for r in train_rows]))
     ax0.set_xlabel("step")
     ax0.set_ylabel("training loss")
     ax0.legend()
@@ -34,3 +34,8 @@ def plot_curves(metrics_path: str | os.PathLike, out_path: str | os.PathLike, ti
     fig.tight_layout()
     fig.savefig(out_path, dpi=100)
     plt.close(fig)
+
+
+def loss_axis_scale(losses) -> str:
+    """"log" when every loss is positive (L1, L2), else "linear" (the log_rmse loss is a log, often below 0)."""
+    return "log" if all(v > 0 for v in losses) else "linear"
