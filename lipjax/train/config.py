@@ -87,7 +87,7 @@ class TrainConfig:
     warmup_steps: int = 100
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
-    loss: str = "l2"  # lipjax.train.losses.LOSS_KINDS ("l2", "l1", "log_rmse"); experiments/configs/ set "l1"
+    loss: str = "l2"  # lipjax.train.losses.LOSS_KINDS; experiments/configs/ set "l1", lip_any "log_rmse"
     loss_scale: str = "max_depth"  # depth errors in units of: the model's max depth, or "samples" (see __post_init__)
     inverse_depth_weight: float = 0.0  # weight of lipjax.train.losses.inverse_depth_loss (1/m) added to the depth loss
     inverse_depth_floor_m: float = 1.0
