@@ -8,10 +8,11 @@ import jax.numpy as jnp
 import optax
 
 
-def masked_mean(values: jax.Array, mask: jax.Array) -> jax.Array:
-    """Mean of `values` over the pixels where `mask` is True (0 when the mask is empty)."""
+def masked_mean(values: jax.Array, mask: jax.Array, axis=None) -> jax.Array:
+    """Mean of `values` over the pixels where `mask` is True (0 when the mask is empty), over `axis` (all axes by
+    default; (-2, -1): one mean per image of a (B, H, W) batch)."""
     mask = mask.astype(values.dtype)
-    return jnp.sum(values * mask) / jnp.maximum(jnp.sum(mask), 1.0)
+    return jnp.sum(values * mask, axis=axis) / jnp.maximum(jnp.sum(mask, axis=axis), 1.0)
 
 
 LOSS_KINDS = ("l2", "l1", "log_rmse")
@@ -38,8 +39,7 @@ def depth_loss(pred: jax.Array, gt: jax.Array, valid: jax.Array, *, kind: str = 
     if kind == "l1":
         return masked_mean(jnp.abs(err), valid)
     if kind == "log_rmse":
-        mask = valid.astype(err.dtype)
-        mse = jnp.sum(err**2 * mask, axis=(-2, -1)) / jnp.maximum(jnp.sum(mask, axis=(-2, -1)), 1.0)
+        mse = masked_mean(err**2, valid, axis=(-2, -1))
         # sqrt'(0) is infinite: an image without error (or without valid pixels) gets the eps-floored value
         rmse = jnp.sqrt(jnp.where(mse > 0, mse, 1.0)) * (mse > 0)
         return jnp.mean(jnp.log(rmse + LOG_RMSE_EPS))
