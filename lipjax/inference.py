@@ -26,6 +26,7 @@ from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
 from lipjax.shipped import DEFAULT_MODEL, DEFAULT_MODELS
+from lipjax.spread import spread_on_host
 from lipjax.zbuffer import splat_nearest
 
 
@@ -133,6 +134,10 @@ MIRROR_AVERAGE = False
 # with 200 points: 143 against 238 ms, benchmarks/speed.py); what the ONNX graph computes.
 CROSS_CHECK = True
 
+# Whether the default path spreads the samples' residuals over the frame after resizing a working-size estimate
+# back to full size (`lipjax.spread`; docs/design-notes.md, rule 46). Off until that rule is judged.
+SPREAD_RESIDUALS = False
+
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
 LARGE_FRAME_PIXELS = 2_000_000
 
@@ -205,11 +210,13 @@ def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray)
 
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
-                mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK) -> np.ndarray:
+                mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK,
+                spread: bool = SPREAD_RESIDUALS) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
-    estimate z (h, w) is resized back (bilinear). Then, at any size, the final x-update runs at full size: with
+    estimate z (h, w) is resized back (bilinear) and, with `spread` (SPREAD_RESIDUALS), the samples' residuals
+    y - z are spread over it (`lipjax.spread.spread_residuals`). Then, at any size, the final x-update runs at full size: with
     rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
     measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
     With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With
@@ -237,7 +244,8 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         if (h, w) == (big_h, big_w):
             return np.array(run(rgb, sparse), np.float32)
         small = np.asarray(run(small_rgb, reproject_sparse(sparse, (h, w))), np.float32)
-        return cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+        z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
+        return spread_on_host(z, sparse, (h, w)) if spread else z
 
     dense = estimate(sparse_m)
     if cross_check and isinstance(completer, Completer):

@@ -34,7 +34,8 @@ than the one lipjax trains with, see that module):
      lipjax.complete on scan lines and, with cross_check=False, on any input (KITTI, 352x1216, HDL-64: median
      |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
-     (cv2's INTER_LINEAR) and the measured pixels set back to their measured values. With `mirror=True`
+     (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
+     (lipjax.spread), and the measured pixels set back to their measured values. With `mirror=True`
      (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
      estimates are averaged after flipping the second back, as `lipjax.complete(..., mirror=True)` does.
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
@@ -58,10 +59,11 @@ import jax.numpy as jnp
 
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import MIRROR_AVERAGE, Completer
+from lipjax.inference import MIRROR_AVERAGE, SPREAD_RESIDUALS, Completer
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import working_size
+from lipjax.spread import spread_residuals, spread_sigmas_px
 
 INPUT_NAMES, OUTPUT_NAMES = ("rgb", "sparse"), ("depth",)
 DEFAULT_SPACING_PX = 4.6  # a 64-beam scan on a KITTI frame (~20,000 samples on 352x1216): the robot / car case
@@ -100,10 +102,11 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
 
 
 def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int], *,
-                    mirror: bool = MIRROR_AVERAGE):
+                    mirror: bool = MIRROR_AVERAGE, spread: bool = SPREAD_RESIDUALS):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
     graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
-    average with the mirror-image frame as lipjax.complete does (lipjax.inference.MIRROR_AVERAGE)."""
+    average with the mirror-image frame as lipjax.complete does (lipjax.inference.MIRROR_AVERAGE); `spread`: spread
+    the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS)."""
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
     unknown = set(config.host_input_names) - {"z0"}
@@ -124,7 +127,11 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
             depth = 0.5 * (both[:len(small)] + flip(both[len(small):]))
         else:
             depth = model(small_rgb, small)
-        return jnp.where(sparse > 0, sparse, resize_bilinear(depth, frame) if resized else depth)
+        if resized:
+            depth = resize_bilinear(depth, frame)
+            if spread:
+                depth = spread_residuals(depth, sparse, spread_sigmas_px(frame, working))
+        return jnp.where(sparse > 0, sparse, depth)
 
     return run
 

@@ -216,3 +216,28 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
                                inference.complete_frame(completer, rgb, sparse, mirror=True), rtol=0, atol=1e-6)
     with pytest.raises(lipjax.InputError, match="mirror averaging is for learned models; drop --mirror"):
         lipjax.complete(rgb, sparse, model="linear", mirror=True)
+
+
+def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estimate():
+    """complete_at(spread=True) at a working size: z resized back (bilinear), then lipjax.spread.spread_residuals with
+    half a working pixel, then the measured pixels set back; at full size nothing is spread."""
+    import cv2
+
+    from lipjax.inference import complete_at, reproject_sparse
+    from lipjax.spread import spread_residuals
+
+    completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
+    rng = np.random.default_rng(6)
+    rgb = rng.integers(0, 256, (40, 56, 3), dtype=np.uint8)
+    sparse = np.where(rng.random((40, 56)) < 0.05, rng.uniform(1, 8, (40, 56)), 0).astype(np.float32)
+    small = completer(cv2.resize(rgb, (28, 20), interpolation=cv2.INTER_AREA), reproject_sparse(sparse, (20, 28)))
+    z = cv2.resize(np.asarray(small, np.float32), (56, 40), interpolation=cv2.INTER_LINEAR)
+    expected = np.array(spread_residuals(z, sparse, (1.0, 1.0)))
+    expected[sparse > 0] = sparse[sparse > 0]
+    got = complete_at(completer, rgb, sparse, (20, 28), cross_check=False, spread=True)
+    np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-5)
+    plain = complete_at(completer, rgb, sparse, (20, 28), cross_check=False, spread=False)
+    assert np.abs(got - plain).max() > 1e-3
+    np.testing.assert_array_equal(got[sparse > 0], sparse[sparse > 0])
+    full = [complete_at(completer, rgb, sparse, (40, 56), cross_check=False, spread=s) for s in (True, False)]
+    np.testing.assert_array_equal(*full)

@@ -1,0 +1,84 @@
+"""lipjax.spread: the samples' residuals spread over the full-size estimate, against closed forms and scipy."""
+import numpy as np
+import pytest
+import scipy.ndimage
+
+from lipjax.resample import gaussian_kernel, gaussian_taps, resample_axis
+from lipjax.spread import DELTA, spread_on_host, spread_residuals, spread_sigmas_px
+
+
+def test_gaussian_taps_are_the_normalised_kernel_cut_at_the_borders():
+    offsets, kernel = gaussian_kernel(1.5)
+    assert offsets[0] == -5 and offsets[-1] == 5 and kernel.sum() == pytest.approx(1.0)
+    np.testing.assert_allclose(kernel / kernel.max(), np.exp(-0.5 * (offsets / 1.5) ** 2), rtol=1e-6)
+    idx, wt = gaussian_taps(20, 1.5)
+    dense = np.zeros((20, 20))
+    for o in range(20):
+        np.add.at(dense[o], idx[o], wt[o])
+    for o in range(20):  # row o of the blur matrix: the kernel centred on o, what falls outside dropped
+        for d, k in zip(offsets, kernel):
+            if 0 <= o + d < 20:
+                assert dense[o, o + d] == pytest.approx(k, rel=1e-6)
+    assert dense[10].sum() == pytest.approx(1.0, rel=1e-6) and dense[0].sum() == pytest.approx(kernel[5:].sum())
+    with pytest.raises(ValueError, match="sigma"):
+        gaussian_taps(10, 0.0)
+
+
+def test_a_lone_sample_keeps_its_residual_over_one_plus_delta_and_fades_as_the_gaussian():
+    """z = 3 m everywhere, one sample y = 5 m: x = 3 + 2 g(dy) g(dx) / (g(dy) g(dx) + DELTA g(0)^2), and exactly z
+    beyond the kernel's reach."""
+    h, w, sigmas = 31, 41, (1.2, 2.0)
+    z, sparse = np.full((h, w), 3.0, np.float32), np.zeros((h, w), np.float32)
+    sparse[15, 20] = 5.0
+    x = np.asarray(spread_residuals(z, sparse, sigmas))
+    (oy, gy), (ox, gx) = gaussian_kernel(sigmas[0]), gaussian_kernel(sigmas[1])
+    g = np.outer(gy, gx)
+    expected = z.copy()
+    expected[15 + oy[0]:15 + oy[-1] + 1, 20 + ox[0]:20 + ox[-1] + 1] += 2.0 * g / (g + DELTA * g.max())
+    np.testing.assert_allclose(x, expected, rtol=1e-5, atol=1e-6)
+    assert x[15, 20] == pytest.approx(3.0 + 2.0 / (1.0 + DELTA), rel=1e-6)
+    assert x[0, 0] == 3.0 and x[15, 20 + ox[-1] + 1] == 3.0
+
+
+def test_spread_equals_a_normalised_convolution_with_zero_padding():
+    rng = np.random.default_rng(0)
+    h, w, sigmas = 24, 33, (0.9, 1.7)
+    z = rng.uniform(1, 10, (h, w)).astype(np.float32)
+    sparse = np.where(rng.random((h, w)) < 0.1, rng.uniform(1, 10, (h, w)), 0).astype(np.float32)
+    g = np.outer(gaussian_kernel(sigmas[0])[1], gaussian_kernel(sigmas[1])[1])
+    m = (sparse > 0).astype(np.float64)
+    num = scipy.ndimage.correlate(m * (sparse - z), g, mode="constant")
+    den = scipy.ndimage.correlate(m, g, mode="constant")
+    expected = np.maximum(z + num / (den + DELTA * g.max()), 0)
+    np.testing.assert_allclose(np.asarray(spread_residuals(z, sparse, sigmas)), expected, rtol=1e-5, atol=1e-5)
+
+
+def test_nothing_to_spread_leaves_z_and_depth_stays_non_negative():
+    rng = np.random.default_rng(1)
+    z = rng.uniform(1, 10, (16, 20)).astype(np.float32)
+    np.testing.assert_array_equal(np.asarray(spread_residuals(z, np.zeros_like(z), (1.0, 1.0))), z)
+    exact = np.where(rng.random(z.shape) < 0.2, z, 0).astype(np.float32)  # samples where z is already right
+    np.testing.assert_allclose(np.asarray(spread_residuals(z, exact, (1.0, 1.0))), z, rtol=1e-6)
+    far, near = np.full((16, 20), 50.0, np.float32), np.zeros((16, 20), np.float32)
+    far[:, :10] = 0.5  # a sample at 0.1 m next to pixels whose z is 0.5 m, its residual spread from 50 m away
+    near[8, 10] = 0.1
+    assert np.asarray(spread_residuals(far, near, (1.0, 1.0))).min() >= 0.0
+
+
+def test_the_sigmas_are_half_a_working_pixel_and_the_host_path_batches_nothing():
+    assert spread_sigmas_px((352, 1216), (132, 456)) == pytest.approx((0.5 * 352 / 132, 0.5 * 1216 / 456))
+    rng = np.random.default_rng(2)
+    z = rng.uniform(1, 10, (2, 12, 18)).astype(np.float32)
+    sparse = np.where(rng.random(z.shape) < 0.2, rng.uniform(1, 10, z.shape), 0).astype(np.float32)
+    batched = np.asarray(spread_residuals(z, sparse, (1.5, 1.5)))
+    for b in range(2):  # a batch is frame by frame, and the host path (jitted, per shape) is the same function
+        np.testing.assert_allclose(batched[b], np.asarray(spread_residuals(z[b], sparse[b], (1.5, 1.5))), rtol=1e-6)
+        np.testing.assert_allclose(spread_on_host(z[b], sparse[b], (4, 6)), batched[b], rtol=1e-6)
+
+
+def test_resample_axis_with_gaussian_taps_is_a_separable_blur():
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(9, 14)).astype(np.float32)
+    blurred = np.asarray(resample_axis(resample_axis(a, *gaussian_taps(9, 1.0), 0), *gaussian_taps(14, 1.0), 1))
+    _, k = gaussian_kernel(1.0)
+    np.testing.assert_allclose(blurred, scipy.ndimage.correlate(a, np.outer(k, k), mode="constant"), atol=1e-5)
