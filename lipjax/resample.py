@@ -14,8 +14,6 @@ The tables reproduce what the host path (lipjax.inference.complete_at) calls:
   - `bilinear_taps`: cv2.resize(..., INTER_LINEAR) on float32: x = (o + 0.5) / s' - 0.5 with s' = n_out / n_in,
     taps floor(x) and floor(x) + 1 with weights 1 - f, f (f = x - floor(x), in float32 as OpenCV), clamped to the
     first and last pixel at the borders.
-  - `gaussian_taps`: a 1-D Gaussian cut at GAUSSIAN_RADIUS_SIGMAS sigmas, normalised over all its taps, the taps
-    outside the frame dropped (zero padding): the blur of lipjax.spread.
   - `reproject_taps`: lipjax.inference.reproject_sparse's mapping, input pixel j -> output pixel
     min(floor((j + 0.5) n_out / n_in), n_out - 1); output o takes the min over its preimage (nearest depth wins).
 """
@@ -27,7 +25,6 @@ import jax.numpy as jnp
 import numpy as np
 
 AREA_EPS_PX = 1e-3  # OpenCV's threshold for a partial input pixel in an area resize
-GAUSSIAN_RADIUS_SIGMAS = 3.0  # gaussian_taps reach ceil(3 sigma) pixels either side
 
 
 def _table(rows: list[list[tuple[int, float]]], pad_index: int) -> tuple[np.ndarray, np.ndarray]:
@@ -74,23 +71,6 @@ def bilinear_taps(n_in: int, n_out: int) -> tuple[np.ndarray, np.ndarray]:
             j, f = n_in - 1, 0.0
         rows.append([(j, 1.0 - f), (min(j + 1, n_in - 1), f)])
     return _table(rows, 0)
-
-
-def gaussian_kernel(sigma_px: float) -> tuple[np.ndarray, np.ndarray]:
-    """Integer offsets -R..R (R = ceil(GAUSSIAN_RADIUS_SIGMAS sigma_px)) and their Gaussian weights, summing to 1."""
-    if not sigma_px > 0:
-        raise ValueError(f"sigma_px={sigma_px}: a Gaussian's sigma must be positive")
-    radius = math.ceil(GAUSSIAN_RADIUS_SIGMAS * sigma_px)
-    offsets = np.arange(-radius, radius + 1)
-    kernel = np.exp(-0.5 * (offsets / sigma_px) ** 2)
-    return offsets, kernel / kernel.sum()
-
-
-def gaussian_taps(n: int, sigma_px: float) -> tuple[np.ndarray, np.ndarray]:
-    """(n, T) indices and weights of `gaussian_kernel(sigma_px)` along an axis of n pixels, the taps outside [0, n)
-    dropped (the padding reads pixel 0 with weight 0)."""
-    offsets, kernel = gaussian_kernel(sigma_px)
-    return _table([[(o + d, float(k)) for d, k in zip(offsets, kernel) if 0 <= o + d < n] for o in range(n)], 0)
 
 
 def reproject_taps(n_in: int, n_out: int) -> np.ndarray:

@@ -10,21 +10,22 @@ sigma = SIGMA_WORKING_PX working pixels (in full-size pixels (H / h, W / w) time
 
 a normalised convolution of the residuals that fades to z where G * m is small next to delta, about a working
 pixel from every sample. A lone sample keeps r / (1 + DELTA) of its residual on its own pixel; the measured pixels
-are set back exactly afterwards (lipjax.inference.complete_at). G is separable, its taps cut at 3 sigmas and
-dropped outside the frame (zero padding; lipjax.resample.gaussian_taps), so that the same step runs on the host (jitted) and inside the ONNX graph (lipjax.onnx_export).
+are set back exactly afterwards (lipjax.inference.complete_at). G is separable, cut at RADIUS_SIGMAS sigmas,
+with zero padding outside the frame: on the host as cv2.sepFilter2D (`spread_on_host`), in a jax or ONNX graph as
+two convolutions (`spread_residuals`, lipjax.onnx_export).
 """
 from __future__ import annotations
 
-import functools
+import math
 
+import cv2
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-from lipjax.resample import gaussian_kernel, gaussian_taps, resample_axis
-
 SIGMA_WORKING_PX = 0.5  # the Gaussian's sigma, in working pixels (rule 46)
 DELTA = 0.05  # the fade: delta = DELTA x the Gaussian's centre weight (rule 46)
+RADIUS_SIGMAS = 3.0  # the Gaussian's taps reach ceil(RADIUS_SIGMAS sigma) pixels either side
 
 
 def spread_sigmas_px(frame: tuple[int, int], working: tuple[int, int]) -> tuple[float, float]:
@@ -32,26 +33,43 @@ def spread_sigmas_px(frame: tuple[int, int], working: tuple[int, int]) -> tuple[
     return tuple(SIGMA_WORKING_PX * big / small for big, small in zip(frame, working))
 
 
+def gaussian_kernel(sigma_px: float) -> np.ndarray:
+    """The 1-D Gaussian of sigma_px at integer offsets -R..R, R = ceil(RADIUS_SIGMAS sigma_px), summing to 1."""
+    if not sigma_px > 0:
+        raise ValueError(f"sigma_px={sigma_px}: a Gaussian's sigma must be positive")
+    offsets = np.arange(-math.ceil(RADIUS_SIGMAS * sigma_px), math.ceil(RADIUS_SIGMAS * sigma_px) + 1)
+    kernel = np.exp(-0.5 * (offsets / sigma_px) ** 2)
+    return (kernel / kernel.sum()).astype(np.float32)
+
+
+def _delta(kernels) -> float:
+    return DELTA * float(np.prod([k.max() for k in kernels]))
+
+
 def spread_residuals(z: jnp.ndarray, sparse: jnp.ndarray, sigmas_px: tuple[float, float]) -> jnp.ndarray:
     """x (..., H, W) metres from the full-size estimate z and the samples `sparse` (..., H, W) metres, 0 = none:
-    the module docstring's formula with G of (sigma_y, sigma_x) = `sigmas_px`."""
-    (h, w), (sy, sx) = z.shape[-2:], sigmas_px
-    taps_y, taps_x = gaussian_taps(h, sy), gaussian_taps(w, sx)
+    the module docstring's formula with G of (sigma_y, sigma_x) = `sigmas_px`, as two 1-D convolutions with zero
+    padding (jax.lax; what the ONNX graph runs)."""
+    ky, kx = (gaussian_kernel(s) for s in sigmas_px)
+    shape = z.shape
 
-    def blur(a):
-        return resample_axis(resample_axis(a, *taps_y, -2), *taps_x, -1)
+    def blur(a):  # (..., H, W) -> (N, H, W, 1), a column then a row convolution, back
+        a = a.reshape((-1,) + shape[-2:] + (1,))
+        for k, pad in ((ky.reshape(-1, 1, 1, 1), ((len(ky) // 2,) * 2, (0, 0))),
+                       (kx.reshape(1, -1, 1, 1), ((0, 0), (len(kx) // 2,) * 2))):
+            a = jax.lax.conv_general_dilated(a, jnp.asarray(k), (1, 1), pad, dimension_numbers=("NHWC", "HWIO", "NHWC"))
+        return a.reshape(shape)
 
     m = (sparse > 0).astype(jnp.float32)
-    delta = DELTA * float(np.prod([gaussian_kernel(s)[1].max() for s in sigmas_px]))
-    return jnp.maximum(z + blur(m * (sparse - z)) / (blur(m) + delta), 0.0)
-
-
-@functools.partial(jax.jit, static_argnames="sigmas_px")
-def _spread_jit(z, sparse, sigmas_px):
-    return spread_residuals(z, sparse, sigmas_px)
+    return jnp.maximum(z + blur(m * (sparse - z)) / (blur(m) + _delta((ky, kx))), 0.0)
 
 
 def spread_on_host(z: np.ndarray, sparse: np.ndarray, working: tuple[int, int]) -> np.ndarray:
-    """`spread_residuals` of a numpy (H, W) estimate resized up from `working`, compiled once per shape."""
-    sigmas = spread_sigmas_px(z.shape[-2:], working)
-    return np.array(_spread_jit(jnp.asarray(z, jnp.float32), jnp.asarray(sparse, jnp.float32), sigmas))
+    """`spread_residuals` of a numpy (H, W) estimate resized up from `working` (cv2.sepFilter2D, zero padding)."""
+    ky, kx = (gaussian_kernel(s) for s in spread_sigmas_px(z.shape, working))
+    m = (sparse > 0).astype(np.float32)
+
+    def blur(a):
+        return cv2.sepFilter2D(a, cv2.CV_32F, kx, ky, borderType=cv2.BORDER_CONSTANT)
+
+    return np.maximum(z + blur(m * (sparse - z)) / (blur(m) + _delta((ky, kx))), 0.0).astype(np.float32)
