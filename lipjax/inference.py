@@ -219,7 +219,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear) and, with `spread` (SPREAD_RESIDUALS), the samples' residuals
-    y - z are spread over it (`lipjax.spread.spread_residuals`). Then, at any size, the final x-update runs at full size: with
+    y - z are spread over it (`lipjax.spread`). Then, at any size, the final x-update runs at full size: with
     rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
     measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
     With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With

@@ -57,7 +57,8 @@ def spread_residuals(z: jnp.ndarray, sparse: jnp.ndarray, sigmas_px: tuple[float
         a = a.reshape((-1,) + shape[-2:] + (1,))
         for k, pad in ((ky.reshape(-1, 1, 1, 1), ((len(ky) // 2,) * 2, (0, 0))),
                        (kx.reshape(1, -1, 1, 1), ((0, 0), (len(kx) // 2,) * 2))):
-            a = jax.lax.conv_general_dilated(a, jnp.asarray(k), (1, 1), pad, dimension_numbers=("NHWC", "HWIO", "NHWC"))
+            a = jax.lax.conv_general_dilated(a, jnp.asarray(k), (1, 1), pad,
+                                             dimension_numbers=("NHWC", "HWIO", "NHWC"))
         return a.reshape(shape)
 
     m = (sparse > 0).astype(jnp.float32)

@@ -28,7 +28,7 @@ LAYERS = {
     # 0: the maths and the leaves (no lipjax imports but within this layer)
     "lipjax.operators": 0, "lipjax.admm": 0, "lipjax.fill": 0, "lipjax.priors": 0, "lipjax.interfaces": 0,
     "lipjax.metrics": 0, "lipjax.zbuffer": 0, "lipjax.viz": 0, "lipjax.shipped": 0, "lipjax.utils": 0,
-    "lipjax.resolution": 0, "lipjax.resample": 0, "lipjax.jaxpr_to_onnx": 0,
+    "lipjax.resolution": 0, "lipjax.resample": 0, "lipjax.spread": 0, "lipjax.jaxpr_to_onnx": 0,
     "lipjax.console": 0,
     # 1: frames: data sets, samplers, the synthetic renderer, input checks, hand-crafted completers
     "lipjax.data": 1, "lipjax.pointcloud": 1, "lipjax.inputs": 1, "lipjax.classical": 1,
