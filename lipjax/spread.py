@@ -43,6 +43,7 @@ def gaussian_kernel(sigma_px: float) -> np.ndarray:
 
 
 def _delta(kernels) -> float:
+    """delta = DELTA G(0, 0) for the separable G of these 1-D kernels."""
     return DELTA * float(np.prod([k.max() for k in kernels]))
 
 

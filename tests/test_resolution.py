@@ -18,6 +18,7 @@ from lipjax.resolution import (
     sample_spacing_px,
     working_size,
 )
+from lipjax.spread import spread_on_host
 
 
 def _sparse(h, w, n, seed=0):
@@ -77,10 +78,12 @@ def test_complete_at_keeps_every_measured_pixel():
     out = inference.complete_at(_LinearAtAnySize(), rgb, sparse, (20, 27))
     assert out.shape == (48, 64) and out.dtype == np.float32
     np.testing.assert_array_equal(out[sparse > 0], sparse[sparse > 0])
-    # elsewhere: the small estimate resized back (bilinear), here the small linear fill
+    # elsewhere: the small estimate (here the small linear fill) resized back (bilinear), the residuals spread
     small = linear_fill(inference.reproject_sparse(sparse, (20, 27)))
     back = cv2.resize(small, (64, 48), interpolation=cv2.INTER_LINEAR)
-    np.testing.assert_allclose(out[sparse == 0], back[sparse == 0], rtol=1e-6)
+    np.testing.assert_allclose(out[sparse == 0], spread_on_host(back, sparse, (20, 27))[sparse == 0], rtol=1e-6)
+    plain = inference.complete_at(_LinearAtAnySize(), rgb, sparse, (20, 27), spread=False)
+    np.testing.assert_allclose(plain[sparse == 0], back[sparse == 0], rtol=1e-6)
 
 
 def test_frame_size_follows_the_samples_for_learned_models_only():
