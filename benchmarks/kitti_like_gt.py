@@ -1,6 +1,7 @@
 """Synthetic streets scored where KITTI's ground truth would lie: near the LiDAR's own scan lines.
 
     python benchmarks/kitti_like_gt.py [--model lip-any] [--frames 24] [--start 8] [--sampler lidar:hdl64]
+                                       [--figure docs/results/kitti_like_gt.png]
 
 KITTI's depth ground truth is LiDAR too: 11 sweeps accumulated around each frame, so its valid pixels lie near
 scan lines, where the input's samples are, and nowhere above the top beam. The synthetic suite
@@ -12,7 +13,9 @@ Delaunay linear fill, on the unsampled pixels:
     ahead of the camera and pitched PITCH_DEG[0] to PITCH_DEG[1] degrees, azimuth steps of AZIMUTH_STEP_DEG
     (about half the synthetic test pixels).
 It prints each frame's two ratios to linear and their geometric means (< 1: the model wins). docs/design-notes.md,
-rule 46, says why it was written and what it decided.
+rule 46, says why it was written and what it decided. `--figure` draws the first street: the image, the KITTI-like
+mask, and where the default path's squared error exceeds linear's (red) or falls below it (blue) on that mask,
+with and without the samples' residuals spread (`lipjax.spread`).
 """
 from __future__ import annotations
 
@@ -28,7 +31,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from benchmarks.generalisation import STREET, geometric_mean  # noqa: E402
 from lipjax.data.sampling import LidarSampler, sampler_from_spec  # noqa: E402
 from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_frame  # noqa: E402
+from lipjax.inference import complete_at, complete_frame, frame_size  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 
 SWEEPS = 11  # KITTI accumulates 11 LiDAR sweeps around each frame
@@ -52,12 +55,42 @@ def ratio(pred: np.ndarray, ref: np.ndarray, gt: np.ndarray, keep: np.ndarray) -
     return float(np.sqrt(np.mean((pred[keep] - gt[keep]) ** 2) / np.mean((ref[keep] - gt[keep]) ** 2)))
 
 
+def draw(path: str, model, sample, sparse: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> None:
+    """The --figure of one street (module docstring)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    size = frame_size(model, sparse)
+    keep = mask & (sparse <= 0)
+    panels = [("the image", sample.rgb), ("KITTI-like mask (white)", keep)]
+    for spread in (False, True):
+        pred = complete_at(model, sample.rgb, sparse, size, spread=spread)
+        diff = np.where(keep, (pred - sample.depth) ** 2 - (ref - sample.depth) ** 2, np.nan)
+        rmse = ratio(pred, ref, sample.depth, keep)
+        panels.append((f"model SE - linear SE, {'with' if spread else 'without'} spreading ({rmse:.3f}x linear RMSE)",
+                       diff))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(12, 3.4 * len(panels)))
+    for ax, (title, image) in zip(axes, panels):
+        if image.ndim == 2 and image.dtype != bool:
+            ax.imshow(image, cmap="bwr", vmin=-4.0, vmax=4.0)  # m^2: red, the model is worse there
+        else:
+            ax.imshow(image, cmap="gray" if image.ndim == 2 else None)
+        ax.set_title(title)
+        ax.axis("off")
+    fig.tight_layout()
+    fig.savefig(path, dpi=60)
+    print(f"wrote {path}")
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="lip-any", help="a shipped model's name or an exported model's path")
     parser.add_argument("--frames", type=int, default=24)
     parser.add_argument("--start", type=int, default=8, help="the first test street (rule 46 prototyped on 0-7)")
     parser.add_argument("--sampler", default="lidar:hdl64", help="the input pattern (lipjax.data.sampling spec)")
+    parser.add_argument("--figure", help="draw the first street to this PNG (module docstring)")
     args = parser.parse_args(argv)
     model, linear = get_completer(args.model), get_completer("linear")
     streets = SyntheticDataset("outdoor", "test", size=args.start + args.frames, height=STREET[0], width=STREET[1])
@@ -71,6 +104,8 @@ def main(argv=None) -> None:
         every.append(ratio(pred, ref, sample.depth, sample.valid & unsampled))
         mask = kitti_like_mask(sample)
         kitti.append(ratio(pred, ref, sample.depth, mask & unsampled))
+        if args.figure and i == args.start:
+            draw(args.figure, model, sample, sparse, ref, mask)
         tqdm.write(f"frame {i:3d}: every pixel {every[-1]:.4f}, KITTI-like mask {kitti[-1]:.4f} "
                    f"({mask.mean():.0%} of the pixels)")
     print(f"{args.model} on {args.frames} test streets {STREET[0]}x{STREET[1]}, {args.sampler}, RMSE ratio to linear "
