@@ -52,10 +52,12 @@ def test_nothing_to_spread_leaves_z_and_depth_stays_non_negative():
     np.testing.assert_array_equal(np.asarray(spread_residuals(z, np.zeros_like(z), (1.0, 1.0))), z)
     exact = np.where(rng.random(z.shape) < 0.2, z, 0).astype(np.float32)  # samples where z is already right
     np.testing.assert_allclose(np.asarray(spread_residuals(z, exact, (1.0, 1.0))), z, rtol=1e-6)
-    far, near = np.full((16, 20), 50.0, np.float32), np.zeros((16, 20), np.float32)
-    far[:, :10] = 0.5  # a sample at 0.1 m next to pixels whose z is 0.5 m, its residual spread from 50 m away
-    near[8, 10] = 0.1
-    assert np.asarray(spread_residuals(far, near, (1.0, 1.0))).min() >= 0.0
+    z = np.full((16, 20), 50.0, np.float32)
+    z[:, :10] = 0.5  # z jumps from 0.5 m to 50 m between columns 9 and 10
+    sample = np.zeros_like(z)
+    sample[8, 10] = 0.1  # a sample at 0.1 m where z is 50 m: r = -49.9 m, spread onto column 9 where z is 0.5 m
+    x = np.asarray(spread_residuals(z, sample, (1.0, 1.0)))
+    assert x.min() == 0.0 and x[8, 9] == 0.0  # 0.5 + ~0.6 x (-49.9) would be negative: clipped at 0
 
 
 def test_the_sigmas_are_half_a_working_pixel_and_a_batch_is_frame_by_frame():
