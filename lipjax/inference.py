@@ -138,7 +138,9 @@ CROSS_CHECK = True
 # resizing a working-size estimate back to full size (`lipjax.spread`). On: chosen by rule 46 (docs/design-notes.md)
 # with the 724,000-image lip-any: `benchmarks/generalisation.py --frames 8 --no-cross-check` 0.708148 -> 0.706272
 # (streets HDL-64 0.428 -> 0.421, VLP-32 0.806 -> 0.798, no setting worse) and 24 synthetic streets with HDL-64
-# scored where KITTI's ground truth would lie (`benchmarks/kitti_like_gt.py`) 1.114 -> 1.028 x linear.
+# scored where KITTI's ground truth would lie (`benchmarks/kitti_like_gt.py`) 1.114 -> 1.028 x linear; scan lines
+# with sigmas of their own since rule 47 (772,000-image lip-any: suite 0.696992 -> 0.696054, those streets 1.024 ->
+# 0.991 x linear).
 SPREAD_RESIDUALS = True
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
@@ -219,7 +221,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear) and, with `spread` (SPREAD_RESIDUALS), the samples' residuals
-    y - z are spread over it (`lipjax.spread`). Then, at any size, the final x-update runs at full size: with
+    y - z are spread over it (`lipjax.spread`; scan lines get their own sigmas). Then, at any size, the final x-update runs at full size: with
     rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
     measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
     With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With
@@ -243,12 +245,14 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     run = functools.partial(mirror_averaged, completer) if mirror else completer
     small_rgb = rgb if (h, w) == (big_h, big_w) else cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
 
+    scan_lines = spread and (h, w) != (big_h, big_w) and is_lidar_pattern(sparse_m)  # the spread's sigmas
+
     def estimate(sparse: np.ndarray) -> np.ndarray:  # z at full size from a (H, W) sparse map, before any set-back
         if (h, w) == (big_h, big_w):
             return np.array(run(rgb, sparse), np.float32)
         small = np.asarray(run(small_rgb, reproject_sparse(sparse, (h, w))), np.float32)
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
-        return spread_on_host(z, sparse, (h, w)) if spread else z
+        return spread_on_host(z, sparse, (h, w), scan_lines) if spread else z
 
     dense = estimate(sparse_m)
     if cross_check and isinstance(completer, Completer):

@@ -35,7 +35,7 @@ than the one lipjax trains with, see that module):
      |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
-     (lipjax.spread), and the measured pixels set back to their measured values. With `mirror=True`
+     (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured pixels set back to their measured values. With `mirror=True`
      (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
      estimates are averaged after flipping the second back, as `lipjax.complete(..., mirror=True)` does.
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
@@ -102,11 +102,12 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
 
 
 def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int], *,
-                    mirror: bool = MIRROR_AVERAGE, spread: bool = SPREAD_RESIDUALS):
+                    mirror: bool = MIRROR_AVERAGE, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
     graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
     average with the mirror-image frame as lipjax.complete does (lipjax.inference.MIRROR_AVERAGE); `spread`: spread
-    the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS)."""
+    the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS), with the sigmas
+    of LiDAR scan lines or (`scan_lines=False`) of scattered samples (lipjax.spread.spread_sigmas_px)."""
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
     unknown = set(config.host_input_names) - {"z0"}
@@ -130,7 +131,7 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
         if resized:
             depth = resize_bilinear(depth, frame)
             if spread:
-                depth = spread_residuals(depth, sparse, spread_sigmas_px(frame, working))
+                depth = spread_residuals(depth, sparse, spread_sigmas_px(frame, working, scan_lines))
         return jnp.where(sparse > 0, sparse, depth)
 
     return run
@@ -210,7 +211,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
                 "mirror_averaged": str(bool(mirror)).lower()}
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
-    graph = inference_graph(completer, (height, width), working, mirror=mirror)
+    graph = inference_graph(completer, (height, width), working, mirror=mirror, scan_lines=scan_lines)
     model = jaxpr_to_onnx.convert(graph, specs, INPUT_NAMES, OUTPUT_NAMES, metadata, doc=__doc__.split("\n")[0])
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -4,7 +4,8 @@ Below full size the learned prox runs on a coarser grid (lipjax.resolution), and
 (bilinear), cannot follow the measured depths y between working pixels: near the samples the full-size linear
 fill is closer than z (seen on renders scored where KITTI's ground truth lies: docs/design-notes.md, rule 46).
 The samples give it back. With r = y - z at the measured pixels (m = 1, else 0) and G a Gaussian of
-sigma = SIGMA_WORKING_PX working pixels (in full-size pixels (H / h, W / w) times that, one sigma per axis),
+sigma = SIGMA_WORKING_PX working pixels along both axes for scattered samples and SCAN_LINE_SIGMAS_WORKING_PX
+(across the lines, along them) for LiDAR scan lines (in full-size pixels (H / h, W / w) times those),
 
     x = max(z + (G * (m r)) / (G * m + delta), 0),     delta = DELTA G(0, 0)
 
@@ -23,14 +24,20 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-SIGMA_WORKING_PX = 0.5  # the Gaussian's sigma, in working pixels (rule 46)
+SIGMA_WORKING_PX = 0.5  # the Gaussian's sigma for scattered samples, in working pixels (rule 46)
+# LiDAR scan lines (sigma across the lines = along the rows' axis, sigma along them), in working pixels (rule 47):
+# their samples lie a pixel or two apart along a line and several working pixels apart across the lines
+SCAN_LINE_SIGMAS_WORKING_PX = (1.0, 0.25)
 DELTA = 0.05  # the fade: delta = DELTA x the Gaussian's centre weight (rule 46)
 RADIUS_SIGMAS = 3.0  # the Gaussian's taps reach ceil(RADIUS_SIGMAS sigma) pixels either side
 
 
-def spread_sigmas_px(frame: tuple[int, int], working: tuple[int, int]) -> tuple[float, float]:
-    """(sigma_y, sigma_x) in full-size pixels: SIGMA_WORKING_PX working pixels of `working` inside `frame`."""
-    return tuple(SIGMA_WORKING_PX * big / small for big, small in zip(frame, working))
+def spread_sigmas_px(frame: tuple[int, int], working: tuple[int, int], scan_lines: bool = False
+                     ) -> tuple[float, float]:
+    """(sigma_y, sigma_x) in full-size pixels: SIGMA_WORKING_PX working pixels of `working` inside `frame` both ways,
+    or with `scan_lines` (samples in LiDAR scan lines, lipjax.inputs.is_lidar_pattern) SCAN_LINE_SIGMAS_WORKING_PX."""
+    sigmas = SCAN_LINE_SIGMAS_WORKING_PX if scan_lines else (SIGMA_WORKING_PX, SIGMA_WORKING_PX)
+    return tuple(sigma * big / small for sigma, big, small in zip(sigmas, frame, working))
 
 
 def gaussian_kernel(sigma_px: float) -> np.ndarray:
@@ -66,9 +73,11 @@ def spread_residuals(z: jnp.ndarray, sparse: jnp.ndarray, sigmas_px: tuple[float
     return jnp.maximum(z + blur(m * (sparse - z)) / (blur(m) + _delta((ky, kx))), 0.0)
 
 
-def spread_on_host(z: np.ndarray, sparse: np.ndarray, working: tuple[int, int]) -> np.ndarray:
-    """`spread_residuals` of a numpy (H, W) estimate resized up from `working` (cv2.sepFilter2D, zero padding)."""
-    ky, kx = (gaussian_kernel(s) for s in spread_sigmas_px(z.shape, working))
+def spread_on_host(z: np.ndarray, sparse: np.ndarray, working: tuple[int, int], scan_lines: bool = False
+                   ) -> np.ndarray:
+    """`spread_residuals` of a numpy (H, W) estimate resized up from `working`, with the sigmas of
+    `spread_sigmas_px(..., scan_lines)` (cv2.sepFilter2D, zero padding)."""
+    ky, kx = (gaussian_kernel(s) for s in spread_sigmas_px(z.shape, working, scan_lines))
     m = (sparse > 0).astype(np.float32)
 
     def blur(a):

@@ -218,13 +218,15 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
         lipjax.complete(rgb, sparse, model="linear", mirror=True)
 
 
+@pytest.mark.filterwarnings("ignore:samples in LiDAR scan lines")  # a tiny model trained on neither
 def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estimate():
     """complete_at(spread=True) at a working size: z resized back (bilinear), then lipjax.spread.spread_residuals with
-    half a working pixel, then the measured pixels set back; at full size nothing is spread."""
+    half a working pixel (scattered samples; scan lines with their own sigmas), then the measured pixels set back; at
+    full size nothing is spread."""
     import cv2
 
-    from lipjax.inference import complete_at, reproject_sparse
-    from lipjax.spread import spread_residuals
+    from lipjax.inference import complete_at, is_lidar_pattern, reproject_sparse
+    from lipjax.spread import spread_on_host, spread_residuals
 
     completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
     rng = np.random.default_rng(6)
@@ -241,3 +243,12 @@ def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estim
     np.testing.assert_array_equal(got[sparse > 0], sparse[sparse > 0])
     full = [complete_at(completer, rgb, sparse, (40, 56), cross_check=False, spread=s) for s in (True, False)]
     np.testing.assert_array_equal(*full)
+    lines = np.zeros_like(sparse)  # LiDAR scan lines: the spread's sigmas are those of scan lines (rule 47)
+    lines[1::4] = np.where(rng.random((10, 56)) < 0.8, rng.uniform(1, 8, (10, 56)), 0)
+    assert is_lidar_pattern(lines)
+    small = completer(cv2.resize(rgb, (28, 20), interpolation=cv2.INTER_AREA), reproject_sparse(lines, (20, 28)))
+    z = cv2.resize(np.asarray(small, np.float32), (56, 40), interpolation=cv2.INTER_LINEAR)
+    expected = spread_on_host(z, lines, (20, 28), scan_lines=True)
+    expected[lines > 0] = lines[lines > 0]
+    np.testing.assert_allclose(complete_at(completer, rgb, lines, (20, 28)), expected, rtol=1e-5, atol=1e-5)
+    assert np.abs(spread_on_host(z, lines, (20, 28)) - expected)[lines == 0].max() > 1e-3

@@ -98,7 +98,8 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
     lipjax.complete fills linearly and the graph equals the model's nearest twin, not the model itself; with and
     without mirror averaging."""
     h, w = 128, 160
-    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, mirror=mirror)
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, scan_lines=False,
+                          mirror=mirror)
     assert written.working == (64, 80) and written.replaced_fill == "auto"
     assert "instead of the model's 'auto'" in written.summary() and "64x80" in written.summary()
     rng = np.random.default_rng(3)
@@ -106,7 +107,8 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
     sparse = np.zeros((1, h, w), np.float32)
     sparse.reshape(-1)[rng.choice(h * w, 10, replace=False)] = rng.uniform(1, 8, 10)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    in_jax = np.asarray(jax.jit(inference_graph(auto_model, (h, w), (64, 80), mirror=mirror))(rgb, sparse))
+    graph = inference_graph(auto_model, (h, w), (64, 80), mirror=mirror, scan_lines=False)
+    in_jax = np.asarray(jax.jit(graph)(rgb, sparse))
     np.testing.assert_allclose(got, in_jax, rtol=1e-5, atol=1e-5)
     expected = lipjax.complete(rgb[0], sparse[0], model=nearest_twin(auto_model), mirror=mirror)
     np.testing.assert_allclose(got[0], expected, rtol=1e-5, atol=1e-4)
@@ -130,6 +132,24 @@ def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_mo
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
     expected = np.stack([lipjax.complete(c, s, model=auto_model) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
+
+
+def test_the_graph_spreads_scan_lines_with_their_own_sigmas_as_complete_does(auto_model):
+    """A 48x64 scan at a 24x32 working size: the jax graph (scan_lines=True) equals complete_at, whose spread uses
+    the scan-line sigmas (lipjax.spread.SCAN_LINE_SIGMAS_WORKING_PX) for this input; scattered sigmas differ."""
+    from lipjax.inference import complete_at
+
+    h, w = 48, 64
+    rng = np.random.default_rng(7)
+    rgb = rng.integers(0, 256, (1, h, w, 3), dtype=np.uint8)
+    sparse = np.zeros((1, h, w), np.float32)
+    sparse[:, 1::4] = np.where(rng.random((1, 12, w)) < 0.8, rng.uniform(2, 9, (1, 12, w)), 0)
+    assert is_lidar_pattern(sparse[0])
+    host = complete_at(auto_model, rgb[0], sparse[0], (24, 32))
+    lines, scattered = (np.asarray(jax.jit(inference_graph(auto_model, (h, w), (24, 32), scan_lines=s))(rgb, sparse))
+                        for s in (True, False))
+    np.testing.assert_allclose(lines[0], host, rtol=1e-5, atol=1e-4)
+    assert np.abs(scattered[0] - host).max() > 1e-3
 
 
 @pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}, {"mirror": True}])

@@ -60,8 +60,10 @@ def test_nothing_to_spread_leaves_z_and_depth_stays_non_negative():
     assert x.min() == 0.0 and x[8, 9] == 0.0  # 0.5 + ~0.6 x (-49.9) would be negative: clipped at 0
 
 
-def test_the_sigmas_are_half_a_working_pixel_and_a_batch_is_frame_by_frame():
+def test_the_sigmas_in_working_pixels_and_a_batch_is_frame_by_frame():
     assert spread_sigmas_px((352, 1216), (132, 456)) == pytest.approx((0.5 * 352 / 132, 0.5 * 1216 / 456))
+    # scan lines: a working pixel across the lines (rows), a quarter along them (rule 47)
+    assert spread_sigmas_px((352, 1216), (132, 456), scan_lines=True) == pytest.approx((352 / 132, 0.25 * 1216 / 456))
     rng = np.random.default_rng(2)
     z = rng.uniform(1, 10, (2, 12, 18)).astype(np.float32)
     sparse = np.where(rng.random(z.shape) < 0.2, rng.uniform(1, 10, z.shape), 0).astype(np.float32)
