@@ -221,9 +221,10 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear) and, with `spread` (SPREAD_RESIDUALS), the samples' residuals
-    y - z are spread over it (`lipjax.spread`; scan lines get their own sigmas). Then, at any size, the final x-update runs at full size: with
-    rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets every measured pixel back to its
-    measured value (the model's own last x-update, with its learned rho, keeps them only approximately).
+    y - z are spread over it (`lipjax.spread`; scan lines get their own sigmas). Then, at any size, the final
+    x-update runs at full size: with rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets
+    every measured pixel back to its measured value (the model's own last x-update, with its learned rho, keeps
+    them only approximately).
     With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With
     `cross_check` (CROSS_CHECK) a learned model's estimate of scattered samples is checked against the linear fill
     on held-out samples and blended with it where it is the worse (`lipjax.crosscheck.cross_checked`).

@@ -35,9 +35,10 @@ than the one lipjax trains with, see that module):
      |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
-     (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured pixels set back to their measured values. With `mirror=True`
-     (`lipjax export --mirror`) the frames and their mirror images run as one batch of 2B, and each frame's two
-     estimates are averaged after flipping the second back, as `lipjax.complete(..., mirror=True)` does.
+     (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured
+     pixels set back to their measured values. With `mirror=True` (`lipjax export --mirror`) the frames and their
+     mirror images run as one batch of 2B, and each frame's two estimates are averaged after flipping the second
+     back, as `lipjax.complete(..., mirror=True)` does.
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
 of the model against the linear fill on held-out samples (lipjax.crosscheck; scattered samples only) is not in the
 graph (it needs the Delaunay fill): the graph is `lipjax.complete(..., cross_check=False)`. No input
