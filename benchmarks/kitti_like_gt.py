@@ -55,22 +55,20 @@ def ratio(pred: np.ndarray, ref: np.ndarray, gt: np.ndarray, keep: np.ndarray) -
     return float(np.sqrt(np.mean((pred[keep] - gt[keep]) ** 2) / np.mean((ref[keep] - gt[keep]) ** 2)))
 
 
-def draw(path: str, model, sample, sparse: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> None:
-    """The --figure of one street (module docstring)."""
+def draw(path: str, model, sample, sparse: np.ndarray, pred: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> None:
+    """The --figure of one street (module docstring); `pred` is the default path's estimate, with the spread."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    size = frame_size(model, sparse)
     keep = mask & (sparse <= 0)
+    plain = complete_at(model, sample.rgb, sparse, frame_size(model, sparse), spread=False)
     panels = [("the image", sample.rgb), ("KITTI-like mask (white)", keep)]
-    for spread in (False, True):
-        pred = complete_at(model, sample.rgb, sparse, size, spread=spread)
-        diff = np.where(keep, (pred - sample.depth) ** 2 - (ref - sample.depth) ** 2, np.nan)
-        rmse = ratio(pred, ref, sample.depth, keep)
-        panels.append((f"model SE - linear SE, {'with' if spread else 'without'} spreading ({rmse:.3f}x linear RMSE)",
-                       diff))
+    for name, estimate in (("without", plain), ("with", pred)):
+        diff = np.where(keep, (estimate - sample.depth) ** 2 - (ref - sample.depth) ** 2, np.nan)
+        rmse = ratio(estimate, ref, sample.depth, keep)
+        panels.append((f"model SE - linear SE, {name} spreading ({rmse:.3f}x linear RMSE)", diff))
     fig, axes = plt.subplots(len(panels), 1, figsize=(12, 3.4 * len(panels)))
     for ax, (title, image) in zip(axes, panels):
         if image.ndim == 2 and image.dtype != bool:
@@ -105,7 +103,7 @@ def main(argv=None) -> None:
         mask = kitti_like_mask(sample)
         kitti.append(ratio(pred, ref, sample.depth, mask & unsampled))
         if args.figure and i == args.start:
-            draw(args.figure, model, sample, sparse, ref, mask)
+            draw(args.figure, model, sample, sparse, pred, ref, mask)
         tqdm.write(f"frame {i:3d}: every pixel {every[-1]:.4f}, KITTI-like mask {kitti[-1]:.4f} "
                    f"({mask.mean():.0%} of the pixels)")
     print(f"{args.model} on {args.frames} test streets {STREET[0]}x{STREET[1]}, {args.sampler}, RMSE ratio to linear "

@@ -44,8 +44,8 @@ def gaussian_kernel(sigma_px: float) -> np.ndarray:
     """The 1-D Gaussian of sigma_px at integer offsets -R..R, R = ceil(RADIUS_SIGMAS sigma_px), summing to 1."""
     if not sigma_px > 0:
         raise ValueError(f"sigma_px={sigma_px}: a Gaussian's sigma must be positive")
-    offsets = np.arange(-math.ceil(RADIUS_SIGMAS * sigma_px), math.ceil(RADIUS_SIGMAS * sigma_px) + 1)
-    kernel = np.exp(-0.5 * (offsets / sigma_px) ** 2)
+    radius = math.ceil(RADIUS_SIGMAS * sigma_px)
+    kernel = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma_px) ** 2)
     return (kernel / kernel.sum()).astype(np.float32)
 
 
