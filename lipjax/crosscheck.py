@@ -32,7 +32,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from lipjax.classical.interpolate import linear_fill
+from lipjax.classical.interpolate import linear_fill, linear_fill_at
 from lipjax.inputs import is_lidar_pattern
 
 HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
@@ -78,7 +78,7 @@ def cross_checked(estimate: Callable[[np.ndarray], np.ndarray], sparse_m: np.nda
     with warnings.catch_warnings():  # the input checks already spoke about the user's frame, not this one
         warnings.simplefilter("ignore")
         z_kept = estimate(kept)
-    w = blend_weight(sparse_m[rows, cols], z_kept[rows, cols], linear_fill(kept)[rows, cols])
+    w = blend_weight(sparse_m[rows, cols], z_kept[rows, cols], linear_fill_at(kept, rows, cols))
     if w == 1.0:
         return z, w
     return (w * z + (1.0 - w) * linear_fill(sparse_m)).astype(np.float32), w

@@ -9,6 +9,7 @@ from lipjax.classical import (
     NearestFill,
     nearest_fill,
 )
+from lipjax.classical.interpolate import linear_fill, linear_fill_at
 from lipjax.classical.colorization import _OFFSETS, luma, neighbour_weights, nested_dissection_order
 from lipjax.methods import CLASSICAL, get_completer
 
@@ -138,6 +139,19 @@ def test_linear_degenerate_samples_fall_back_to_nearest():
     s2 = np.zeros((9, 9), np.float32)
     s2[1, 1], s2[7, 7] = 1.0, 2.0  # two points
     np.testing.assert_array_equal(LinearFill()(_gray(9, 9), s2), nearest_fill(s2))
+
+
+@pytest.mark.parametrize("s", [_random_sparse(23, 31, 40, seed=3), _grid_sparse(29, 41, 30, 4),
+                               _grid_sparse(40, 33, 60, 3, seed=1), _random_sparse(9, 9, 2, seed=4)],
+                         ids=["random", "grid4", "grid3", "two points"])
+def test_linear_fill_at_pixels_equals_the_full_fill_there(s):
+    """On triangle edges, outside the hull, at ties between equidistant samples and at the samples themselves."""
+    rows, cols = np.mgrid[0:s.shape[0], 0:s.shape[1]].reshape(2, -1)
+    np.testing.assert_allclose(linear_fill_at(s, rows, cols), linear_fill(s)[rows, cols], rtol=0, atol=1e-5)
+    line = np.zeros((9, 9), np.float32)
+    line[4, 1], line[4, 5], line[4, 8] = 1.0, 2.0, 3.0  # collinear: the nearest fill, ties included
+    rows, cols = np.mgrid[0:9, 0:9].reshape(2, -1)
+    np.testing.assert_array_equal(linear_fill_at(line, rows, cols), nearest_fill(line).reshape(-1))
 
 
 # IP-Basic: tests/test_ipbasic.py

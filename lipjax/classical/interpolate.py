@@ -97,6 +97,44 @@ def linear_fill(sparse: np.ndarray) -> np.ndarray:
     return dense.astype(np.float32)
 
 
+def linear_fill_at(sparse: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """`linear_fill(sparse)[rows, cols]` (float32 metres) without filling the whole frame: the same Delaunay
+    triangulation, each pixel interpolated in a triangle that holds it (edges included, by the rasteriser's exact
+    integer test), its nearest sample where none does (a pixel exactly as far from two samples asks scipy's distance
+    transform, as the full fill does, which breaks such ties its own way). Equal to the full fill up to rounding; for
+    a few pixels of a large frame (lipjax.crosscheck's held-out samples) it skips the rasterisation and, without
+    ties, the transform. Every pixel is tested against every triangle: for tens of pixels, not for a frame."""
+    ys, xs = np.nonzero(sparse > 0)
+    rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+    d2 = (rows[:, None] - ys[None, :]) ** 2 + (cols[:, None] - xs[None, :]) ** 2  # (n, N) integers: exact
+    values = sparse[ys, xs].astype(np.float64)
+    out = values[np.argmin(d2, axis=1)]
+    inside = np.zeros(rows.shape, bool)
+    simplices = None
+    if ys.size >= 3:
+        try:
+            simplices = spatial.Delaunay(np.stack([ys, xs], axis=1).astype(np.float64)).simplices
+        except spatial.QhullError:  # collinear samples: the full fill is the nearest fill
+            pass
+    if simplices is not None:
+        (y0, y1, y2), (x0, x1, x2) = ys[simplices].T, xs[simplices].T  # (T,) each
+        den = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)  # twice the signed area; 0: a sliver, skipped
+        qy, qx = rows[:, None], cols[:, None]  # against (T,): (n, T) integers
+        a0 = (y1 - y2) * (qx - x2) + (x2 - x1) * (qy - y2)  # den * the barycentric coordinates
+        a1 = (y2 - y0) * (qx - x2) + (x0 - x2) * (qy - y2)
+        sign = np.sign(den)
+        holds = (den != 0) & (sign * a0 >= 0) & (sign * a1 >= 0) & (sign * (den - a0 - a1) >= 0)
+        inside = holds.any(axis=1)
+        t = np.argmax(holds, axis=1)[inside]
+        l0, l1 = a0[inside, t] / den[t], a1[inside, t] / den[t]
+        corners = values[simplices[t]]
+        out[inside] = corners[:, 2] + l0 * (corners[:, 0] - corners[:, 2]) + l1 * (corners[:, 1] - corners[:, 2])
+    tied = ~inside & ((d2 == d2.min(axis=1, keepdims=True)).sum(axis=1) > 1)
+    if tied.any():
+        out[tied] = nearest_fill(sparse)[rows[tied], cols[tied]]
+    return out.astype(np.float32)
+
+
 @dataclasses.dataclass(frozen=True)
 class LinearFill:
     """DepthCompleter: Delaunay piecewise-linear interpolation, nearest fill outside the convex hull (ignores RGB)."""
