@@ -154,6 +154,20 @@ def test_linear_fill_at_pixels_equals_the_full_fill_there(s):
     np.testing.assert_array_equal(linear_fill_at(line, rows, cols), nearest_fill(line).reshape(-1))
 
 
+def test_linear_fill_at_many_pixels_of_dense_input_reads_the_full_fill(monkeypatch):
+    import lipjax.classical.interpolate as interpolate_module
+
+    s = _random_sparse(23, 31, 300, seed=5)
+    rows, cols = np.mgrid[0:23, 0:31].reshape(2, -1)
+    full = []
+    monkeypatch.setattr(interpolate_module, "linear_fill", lambda sparse: full.append(1) or linear_fill(sparse))
+    np.testing.assert_allclose(linear_fill_at(s, rows[:5], cols[:5]), linear_fill(s)[rows[:5], cols[:5]], atol=1e-5)
+    assert not full  # 5 x 300 pairs: pointwise
+    monkeypatch.setattr(interpolate_module, "POINTWISE_PAIRS", 1000)  # 713 x 300 pairs: over it
+    np.testing.assert_allclose(linear_fill_at(s, rows, cols), linear_fill(s)[rows, cols], rtol=0, atol=1e-5)
+    assert full == [1]
+
+
 # IP-Basic: tests/test_ipbasic.py
 
 

@@ -24,6 +24,9 @@ from lipjax.classical.nearest import nearest_fill
 from lipjax.inputs import check_frame
 
 
+POINTWISE_PAIRS = 2_000_000  # linear_fill_at: (pixels x samples) above which the full fill is cheaper and smaller
+
+
 def _rasterise_triangles(points: np.ndarray, values: np.ndarray, simplices: np.ndarray, shape) -> np.ndarray:
     """Linear interpolation on integer pixel centres of every triangle (edges included); NaN outside all triangles.
 
@@ -103,9 +106,12 @@ def linear_fill_at(sparse: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np
     integer test), its nearest sample where none does (a pixel exactly as far from two samples asks scipy's distance
     transform, as the full fill does, which breaks such ties its own way). Equal to the full fill up to rounding; for
     a few pixels of a large frame (lipjax.crosscheck's held-out samples) it skips the rasterisation and, without
-    ties, the transform. Every pixel is tested against every triangle: for tens of pixels, not for a frame."""
+    ties, the transform. Every pixel is tested against every sample and triangle, so above POINTWISE_PAIRS pairs
+    (dense input) the full fill is computed and read instead."""
     ys, xs = np.nonzero(sparse > 0)
     rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
+    if rows.size * ys.size > POINTWISE_PAIRS:
+        return linear_fill(sparse)[rows, cols]
     d2 = (rows[:, None] - ys[None, :]) ** 2 + (cols[:, None] - xs[None, :]) ** 2  # (n, N) integers: exact
     values = sparse[ys, xs].astype(np.float64)
     out = values[np.argmin(d2, axis=1)]
