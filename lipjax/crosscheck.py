@@ -18,11 +18,12 @@ there; it fires on some denser inputs, and on 5 of Table I's 100 frames); where 
 1.23 -> 0.96 x linear; dense depth with holes, which lip-any has not learned: 1.08 -> 0.96) the output leans on the
 linear fill. Scan lines are not checked: random held-out returns lie a pixel from their neighbours on
 the same line, where every fill is right, so they say nothing of the gaps between the lines (and the LiDAR path
-keeps its 10 frames/s). The held-out run uses the working size of all the samples (the same compiled program),
-so the model sees 80 % of its usual density there while the fill needs none: the test leans, if anything, against
-the model. Chosen on synthetic frames only, by a rule fixed before measuring (docs/design-notes.md, "A check
-against the linear fill"). Costs a second run of the model (two more with `mirror`) and one linear fill, two when
-it fires (on dense inputs, such as depth with holes, the Delaunay fills take most of the time); `cross_check=False`
+keeps its 10 frames/s). The held-out run uses the working size the default path gives the kept samples
+(`held_out_size`, rule 48 of docs/design-notes.md): the model sees them as far apart as it was trained to, in 0.8x
+the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames only, by a rule
+fixed before measuring (docs/design-notes.md, "A check against the linear fill"). Costs a second run of the
+model (two more with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires (on dense
+inputs, such as depth with holes, the Delaunay fills take most of the time); `cross_check=False`
 (lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
 """
 from __future__ import annotations
@@ -34,6 +35,7 @@ import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
 from lipjax.inputs import is_lidar_pattern
+from lipjax.resolution import sample_spacing_px, working_size
 
 HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
@@ -54,6 +56,14 @@ def hold_out(sparse_m: np.ndarray, fraction: float = HOLDOUT_FRACTION, seed: int
     kept = np.array(sparse_m, np.float32)
     kept[rows[held], cols[held]] = 0.0
     return kept, rows[held], cols[held]
+
+
+def held_out_size(size: tuple[int, int], kept_m: np.ndarray) -> tuple[int, int]:
+    """(h, w) at which the held-out estimate runs: the working size of the kept samples' own spacing
+    (lipjax.resolution.working_size), where the model sees them as far apart as it was trained to, never more
+    pixels than `size`, the frame's own run (which a caller's max_side may have capped)."""
+    own = working_size(np.shape(kept_m), sample_spacing_px(kept_m))
+    return own if own[0] * own[1] < size[0] * size[1] else tuple(size)
 
 
 def blend_weight(y: np.ndarray, x_m: np.ndarray, x_l: np.ndarray, p_value: float = P_VALUE) -> float:

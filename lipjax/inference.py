@@ -131,7 +131,8 @@ MIRROR_AVERAGE = False
 # fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by a rule
 # on synthetic frames (docs/design-notes.md, "A check against the linear fill"). Off (`cross_check=False`, `lipjax
 # complete --no-cross-check`): the model's estimate alone, run once instead of twice on scattered samples (480x640
-# with 200 points: 143 against 238 ms, benchmarks/speed.py); what the ONNX graph computes.
+# with 200 points, training paused: 98 ms checked (the held-out run at the kept samples' own working size, rule 48)
+# against about 56 ms); what the ONNX graph computes.
 CROSS_CHECK = True
 
 # Whether the default path (`complete_at`, the ONNX graph) spreads the samples' residuals over the frame after
@@ -244,20 +245,20 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
     run = functools.partial(mirror_averaged, completer) if mirror else completer
-    small_rgb = rgb if (h, w) == (big_h, big_w) else cv2.resize(rgb, (w, h), interpolation=cv2.INTER_AREA)
-
     scan_lines = spread and (h, w) != (big_h, big_w) and is_lidar_pattern(sparse_m)  # the spread's sigmas
 
-    def estimate(sparse: np.ndarray) -> np.ndarray:  # z at full size from a (H, W) sparse map, before any set-back
-        if (h, w) == (big_h, big_w):
+    def estimate(sparse: np.ndarray, at: tuple[int, int]) -> np.ndarray:  # z (H, W) from a sparse map, run at `at`
+        if at == (big_h, big_w):
             return np.array(run(rgb, sparse), np.float32)
-        small = np.asarray(run(small_rgb, reproject_sparse(sparse, (h, w))), np.float32)
+        small_rgb = cv2.resize(rgb, at[::-1], interpolation=cv2.INTER_AREA)
+        small = np.asarray(run(small_rgb, reproject_sparse(sparse, at)), np.float32)
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
-        return spread_on_host(z, sparse, (h, w), scan_lines) if spread else z
+        return spread_on_host(z, sparse, at, scan_lines) if spread else z  # before any set-back
 
-    dense = estimate(sparse_m)
+    dense = estimate(sparse_m, (h, w))
     if cross_check and isinstance(completer, Completer):
-        dense, _ = crosscheck.cross_checked(estimate, sparse_m, dense)
+        dense, _ = crosscheck.cross_checked(lambda kept: estimate(kept, crosscheck.held_out_size((h, w), kept)),
+                                            sparse_m, dense)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
     return dense

@@ -119,3 +119,17 @@ def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
     with pytest.warns(UserWarning, match="trained on scattered points"):  # the untrained model's training
         np.testing.assert_array_equal(complete_at(model, rgb, lines, depth.shape),
                                       complete_at(model, rgb, lines, depth.shape, cross_check=False))
+
+
+def test_the_held_out_estimate_runs_where_the_kept_samples_lie_as_far_apart_as_in_training():
+    """200 points on 480x640 run at 196x261; the 160 kept after the hold-out lie sqrt(200 / 160) x further apart, so
+    their working size is that much smaller, and never larger than the frame's own run (a max_side cap)."""
+    from lipjax.resolution import TARGET_SPACING_PX
+
+    sparse = _scattered(np.full((480, 640), 3.0, np.float32), 200)
+    kept, _, _ = crosscheck.hold_out(sparse)
+    s = TARGET_SPACING_PX / math.sqrt(480 * 640 / 160)
+    assert crosscheck.held_out_size((196, 261), kept) == (round(480 * s), round(640 * s)) == (175, 234)
+    assert crosscheck.held_out_size((120, 160), kept) == (120, 160)
+    dense = _scattered(np.full((48, 64), 3.0, np.float32), 2000)  # 1.2 px apart: full size, as the frame
+    assert crosscheck.held_out_size((48, 64), crosscheck.hold_out(dense)[0]) == (48, 64)
