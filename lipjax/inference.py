@@ -14,7 +14,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import os
-import warnings
 from typing import Any
 
 import jax
@@ -27,6 +26,7 @@ from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
 from lipjax.shipped import DEFAULT_MODEL, DEFAULT_MODELS
 from lipjax.spread import spread_on_host
+from lipjax.utils import warn_user
 from lipjax.zbuffer import splat_nearest
 
 
@@ -114,8 +114,8 @@ def default_model(scene: str = "indoor") -> Completer:
     name = DEFAULT_MODELS[scene]
     if name in model_io.available():
         return load_model(name)
-    warnings.warn(f"no trained weights shipped ({name!r} is not in `lipjax models`): using an UNTRAINED "
-                  "model, whose output is only a smooth fill of the samples; pass a model name or path", stacklevel=2)
+    warn_user(f"no trained weights shipped ({name!r} is not in `lipjax models`): using an UNTRAINED model, whose "
+              "output is only a smooth fill of the samples; pass a model name or path")
     return Completer.random()
 
 

@@ -25,13 +25,13 @@ cause (the same text for every frame, so a folder of frames warns once):
 """
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 
 from lipjax.data.folder import KNOWN_DEPTH_SCALES
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.shipped import DEFAULT_MODELS, available
+from lipjax.utils import warn_user
 
 # A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
@@ -205,4 +205,4 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
 
 
 def _warn(message: str) -> None:
-    warnings.warn(message, stacklevel=5)  # _warn, check_for_model, check_inputs, the completer, its caller
+    warn_user(message)  # at the user's line, past check_for_model, check_inputs, the completer, complete_at

@@ -25,6 +25,15 @@ def enable_compilation_cache(path: str | os.PathLike | None = None) -> pathlib.P
     return path
 
 
+def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
+    """warnings.warn pointing at the first caller outside the lipjax package (the user's line, whatever chain of
+    library calls and closures led to the warning; Python 3.12's `skip_file_prefixes`, by hand for 3.11)."""
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame, level = sys._getframe(1), 2
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)
+
 def die_with_parent() -> None:
     """Asks Linux to send this process SIGTERM when its parent dies, even by SIGKILL (prctl PR_SET_PDEATHSIG), so
     that a worker process never outlives the run that started it; elsewhere does nothing."""

@@ -116,9 +116,10 @@ def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
     np.testing.assert_array_equal(checked[~unsampled], sparse[~unsampled])
     lines = np.zeros_like(depth)
     lines[2::4] = depth[2::4]
-    with pytest.warns(UserWarning, match="trained on scattered points"):  # the untrained model's training
+    with pytest.warns(UserWarning, match="trained on scattered points") as warned:  # the untrained model's training
         np.testing.assert_array_equal(complete_at(model, rgb, lines, depth.shape),
                                       complete_at(model, rgb, lines, depth.shape, cross_check=False))
+    assert {w.filename for w in warned} == {__file__}  # each warning points at the caller's line, not lipjax's
 
 
 def test_the_held_out_estimate_runs_where_the_kept_samples_lie_as_far_apart_as_in_training():
