@@ -28,13 +28,12 @@ inputs, such as depth with holes, the Delaunay fills take most of the time); `cr
 """
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 
 import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
-from lipjax.inputs import is_lidar_pattern
+from lipjax.inputs import is_lidar_pattern, quiet_checks
 from lipjax.resolution import sample_spacing_px, working_size
 
 HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
@@ -85,8 +84,7 @@ def cross_checked(estimate: Callable[[np.ndarray], np.ndarray], sparse_m: np.nda
     if not applies(sparse_m):
         return z, 1.0
     kept, rows, cols = hold_out(sparse_m)
-    with warnings.catch_warnings():  # the input checks already spoke about the user's frame, not this one
-        warnings.simplefilter("ignore")
+    with quiet_checks():  # the input checks already spoke about the user's frame, not this one
         z_kept = estimate(kept)
     w = blend_weight(sparse_m[rows, cols], z_kept[rows, cols], linear_fill_at(kept, rows, cols))
     if w == 1.0:

@@ -25,6 +25,9 @@ cause (the same text for every frame, so a folder of frames warns once):
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -204,5 +207,21 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
               f"({100 * trained:.2g} % of the pixels): expect larger errors")
 
 
+_QUIET = contextvars.ContextVar("lipjax_quiet_input_checks", default=False)
+
+
+@contextlib.contextmanager
+def quiet_checks() -> Iterator[None]:
+    """Within: the input checks raise as ever but do not warn (a second look at a frame whose checks already spoke,
+    lipjax.crosscheck's held-out run). Unlike warnings.catch_warnings it leaves the filters alone, whose every
+    change makes Python forget which warnings it has shown (a folder of frames would warn on every frame)."""
+    token = _QUIET.set(True)
+    try:
+        yield
+    finally:
+        _QUIET.reset(token)
+
+
 def _warn(message: str) -> None:
-    warn_user(message)  # at the user's line, past check_for_model, check_inputs, the completer, complete_at
+    if not _QUIET.get():
+        warn_user(message)  # at the user's line, past check_for_model, check_inputs, the completer, complete_at

@@ -34,6 +34,7 @@ def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
 
+
 def die_with_parent() -> None:
     """Asks Linux to send this process SIGTERM when its parent dies, even by SIGKILL (prctl PR_SET_PDEATHSIG), so
     that a worker process never outlives the run that started it; elsewhere does nothing."""

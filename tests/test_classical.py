@@ -148,8 +148,11 @@ def test_linear_fill_at_pixels_equals_the_full_fill_there(s):
     """On triangle edges, outside the hull, at ties between equidistant samples and at the samples themselves."""
     rows, cols = np.mgrid[0:s.shape[0], 0:s.shape[1]].reshape(2, -1)
     np.testing.assert_allclose(linear_fill_at(s, rows, cols), linear_fill(s)[rows, cols], rtol=0, atol=1e-5)
+
+
+def test_linear_fill_at_collinear_samples_is_the_nearest_fill_ties_included():
     line = np.zeros((9, 9), np.float32)
-    line[4, 1], line[4, 5], line[4, 8] = 1.0, 2.0, 3.0  # collinear: the nearest fill, ties included
+    line[4, 1], line[4, 5], line[4, 8] = 1.0, 2.0, 3.0  # no triangle: the full fill is the nearest fill
     rows, cols = np.mgrid[0:9, 0:9].reshape(2, -1)
     np.testing.assert_array_equal(linear_fill_at(line, rows, cols), nearest_fill(line).reshape(-1))
 
@@ -161,11 +164,10 @@ def test_linear_fill_at_many_pixels_of_dense_input_reads_the_full_fill(monkeypat
     rows, cols = np.mgrid[0:23, 0:31].reshape(2, -1)
     full = []
     monkeypatch.setattr(interpolate_module, "linear_fill", lambda sparse: full.append(1) or linear_fill(sparse))
-    np.testing.assert_allclose(linear_fill_at(s, rows[:5], cols[:5]), linear_fill(s)[rows[:5], cols[:5]], atol=1e-5)
-    assert not full  # 5 x 300 pairs: pointwise
-    monkeypatch.setattr(interpolate_module, "POINTWISE_PAIRS", 1000)  # 713 x 300 pairs: over it
+    np.testing.assert_allclose(linear_fill_at(s, rows[:2], cols[:2]), linear_fill(s)[rows[:2], cols[:2]], atol=1e-5)
+    assert not full  # 2 x 300 pairs on 713 pixels: pointwise
     np.testing.assert_allclose(linear_fill_at(s, rows, cols), linear_fill(s)[rows, cols], rtol=0, atol=1e-5)
-    assert full == [1]
+    assert full == [1]  # 713 x 300 pairs: 300 a pixel, over POINTWISE_PAIRS_PER_PIXEL
 
 
 # IP-Basic: tests/test_ipbasic.py

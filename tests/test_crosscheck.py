@@ -1,5 +1,6 @@
 """The per-frame check of a learned model against the linear fill on held-out samples (lipjax.crosscheck)."""
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -134,3 +135,31 @@ def test_the_held_out_estimate_runs_where_the_kept_samples_lie_as_far_apart_as_i
     assert crosscheck.held_out_size((120, 160), kept) == (120, 160)
     dense = _scattered(np.full((48, 64), 3.0, np.float32), 2000)  # 1.2 px apart: full size, as the frame
     assert crosscheck.held_out_size((48, 64), crosscheck.hold_out(dense)[0]) == (48, 64)
+
+
+def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
+    """100 points on 160x200 run at full size; the 80 kept lie 20 px apart, so the held-out run is at 0.8x (128x160):
+    the model sees the resized image there, and every sample is still kept in the output."""
+    depth = _plane(160, 200)
+    sparse = _scattered(depth, 100)
+    sizes = []
+    call = Completer.__call__
+    monkeypatch.setattr(Completer, "__call__", lambda self, rgb, s: sizes.append(rgb.shape[:2]) or call(self, rgb, s))
+    model = Completer.random(LIPConfig(initial_estimate="nearest"))
+    x = complete_at(model, np.full(depth.shape + (3,), 128, np.uint8), sparse, depth.shape)
+    assert sizes == [(160, 200), (128, 160)]
+    np.testing.assert_array_equal(x[sparse > 0], sparse[sparse > 0])
+
+
+def test_a_frame_that_warns_warns_once_from_the_same_line():
+    """The held-out run's checks are quiet without touching the warning filters (whose every change makes Python
+    forget what it has shown): three frames from one line warn once, as a folder of frames should."""
+    depth = np.full((48, 64), 12.0, np.float32)  # beyond the untrained indoor model's 10 m range
+    sparse = _scattered(depth, 300)
+    model = Completer.random(LIPConfig(initial_estimate="nearest"))
+    rgb = np.full(depth.shape + (3,), 128, np.uint8)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("default")
+        for _ in range(3):
+            complete_at(model, rgb, sparse, depth.shape)
+    assert len(shown) == 1 and "10 m range" in str(shown[0].message), [str(w.message) for w in shown]
