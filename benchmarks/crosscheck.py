@@ -1,6 +1,6 @@
 """The default path with and without its check against the linear fill (lipjax.crosscheck), on synthetic frames.
 
-    python benchmarks/crosscheck.py [--model lip-any] [--frames 8] [--json OUT]
+    python benchmarks/crosscheck.py [--model lip-any] [--frames 8] [--json OUT] [--only TEXT]
 
 The settings of benchmarks/generalisation.py that the check applies to (100 or more scattered samples; the scan-line
 settings are unchanged by construction), and two where the model does not fit its input: lip-fast-outdoor (trained
@@ -30,11 +30,13 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default="lip-any", help="a model name or path")
     ap.add_argument("--frames", type=int, default=8, help="test frames per setting")
     ap.add_argument("--json", default=None, help="write the per-frame ratios here")
+    ap.add_argument("--only", default="", help="run only the settings whose name holds this text")
     args = ap.parse_args(argv)
     settings = [(name, args.model, kind, size, spec, variant) for name, kind, size, spec, variant in SETTINGS
                 if not spec.startswith("lidar") and int(spec.split(":")[1]) >= MIN_SAMPLES]
     settings += [("rooms 200 points, street model", "lip-fast-outdoor", "indoor", ROOM, "uniform:200", None),
                  ("rooms, dense depth with holes", args.model, "indoor", ROOM, "holes:0.3", None)]
+    settings = [s for s in settings if args.only in s[0]]
     linear, table = get_completer("linear"), {}
     print(f"{'setting':34s} {'model':18s} plain (wins)   checked (wins)")
     for name, model, kind, size, spec, variant in settings:

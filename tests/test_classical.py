@@ -150,6 +150,53 @@ def test_linear_fill_at_pixels_equals_the_full_fill_there(s):
     np.testing.assert_allclose(linear_fill_at(s, rows, cols), linear_fill(s)[rows, cols], rtol=0, atol=1e-5)
 
 
+def _holes_sparse(h=30, w=40, seed=0):
+    """Dense depth with holes, as a depth camera gives it: 98 % of the pixels, less two rectangles."""
+    s = _random_sparse(h, w, int(0.98 * h * w), seed=seed)
+    s[5:12, 8:20] = 0
+    s[18:26, 25:31] = 0
+    return s
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_linear_fill_of_dense_input_is_delaunay_for_all_the_samples(seed):
+    """Only the edge samples are triangulated; every triangle that holds an unsampled pixel has no sample at all
+    strictly inside its circumcircle (exact integer in-circle test), so the fill is a Delaunay linear fill of every
+    sample; each sample keeps its value, and linear_fill_at reads the same values at the unsampled pixels."""
+    from lipjax.classical.interpolate import _delaunay, _edge_samples
+
+    s = _holes_sparse(seed=seed)
+    ys, xs = _edge_samples(s)
+    assert ys.size < 0.6 * (s > 0).sum()  # the interior of the sampled region is left out
+    simplices = _delaunay(ys, xs)
+    ay, ax = np.nonzero(s > 0)
+    holes = np.argwhere(s == 0)
+    checked = 0
+    for tri in simplices:
+        (y0, y1, y2), (x0, x1, x2) = ys[tri], xs[tri]
+        den = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)
+        if den == 0:
+            continue
+        a0 = (y1 - y2) * (holes[:, 1] - x2) + (x2 - x1) * (holes[:, 0] - y2)
+        a1 = (y2 - y0) * (holes[:, 1] - x2) + (x0 - x2) * (holes[:, 0] - y2)
+        if not np.any((np.sign(den) * a0 >= 0) & (np.sign(den) * a1 >= 0) & (np.sign(den) * (den - a0 - a1) >= 0)):
+            continue  # holds no unsampled pixel
+        dx = np.array([x0, x1, x2])[None, :] - ax[:, None]  # (N, 3): corners relative to every sample
+        dy = np.array([y0, y1, y2])[None, :] - ay[:, None]
+        sq = dx ** 2 + dy ** 2
+        det = (dx[:, 0] * (dy[:, 1] * sq[:, 2] - dy[:, 2] * sq[:, 1])
+               - dy[:, 0] * (dx[:, 1] * sq[:, 2] - dx[:, 2] * sq[:, 1])
+               + sq[:, 0] * (dx[:, 1] * dy[:, 2] - dx[:, 2] * dy[:, 1]))
+        orient = (x1 - x0) * (y2 - y0) - (y1 - y0) * (x2 - x0)
+        assert not np.any(det * np.sign(orient) > 0), tri  # > 0: a sample strictly inside the circumcircle
+        checked += 1
+    assert checked > 10
+    out = linear_fill(s)
+    np.testing.assert_array_equal(out[s > 0], s[s > 0])
+    rows, cols = holes[:40].T
+    np.testing.assert_allclose(linear_fill_at(s, rows, cols), out[rows, cols], rtol=0, atol=1e-5)
+
+
 def test_linear_fill_at_collinear_samples_is_the_nearest_fill_ties_included():
     line = np.zeros((9, 9), np.float32)
     line[4, 1], line[4, 5], line[4, 8] = 1.0, 2.0, 3.0  # no triangle: the full fill is the nearest fill

@@ -163,3 +163,19 @@ def test_a_frame_that_warns_warns_once_from_the_same_line():
         for _ in range(3):
             complete_at(model, rgb, sparse, depth.shape)
     assert len(shown) == 1 and "10 m range" in str(shown[0].message), [str(w.message) for w in shown]
+
+
+def test_dense_input_is_not_checked():
+    """Over DENSE samples per pixel (a depth camera's map with holes) the held-out samples lie a pixel from kept
+    ones, where every fill is right: the default path runs the model once, as with cross_check=False."""
+    from lipjax.inputs import DENSE
+
+    depth = _plane()
+    sparse = _scattered(depth, int(0.9 * depth.size))
+    sparse[10:20, 20:40] = 0
+    assert (sparse > 0).mean() > DENSE and not crosscheck.applies(sparse)
+    assert crosscheck.applies(_scattered(depth, 300))
+    model = Completer.random(LIPConfig(initial_estimate="nearest"))
+    rgb = np.full(depth.shape + (3,), 128, np.uint8)
+    np.testing.assert_array_equal(complete_at(model, rgb, sparse, depth.shape),
+                                  complete_at(model, rgb, sparse, depth.shape, cross_check=False))

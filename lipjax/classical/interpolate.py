@@ -5,6 +5,19 @@ the hull (where linear interpolation is undefined) each pixel takes its nearest 
 samples, or all samples on one line (e.g. a single LiDAR scan line), admit no triangulation: then the whole map
 is the nearest-neighbour fill.
 
+Only the samples on the edge of the sampled region are triangulated (`_edge_samples`: those with an unsampled or
+out-of-frame pixel among their 4 neighbours), which makes dense depth with holes (a depth camera's, stereo's) fast
+(a synthetic 480x640 room with holes: 240,474 samples, 8,767 of them on the edge; 22 s -> 1.2 s beside a training
+run) and leaves scattered samples and scan lines as they were (every such sample is on the edge). The fill at the
+unsampled pixels is still a Delaunay linear fill of all the samples: a Delaunay triangle that holds an unsampled
+lattice pixel other than its corners has an edge of length >= 2 (a lattice triangle with edges of 1 and sqrt(2)
+holds none), so a circumradius R >= 1; a circle through a sample of radius R > 1/sqrt(2) has one of its 4 neighbours
+strictly inside (the one within 45 degrees of the way to the centre: 1 < 2 R cos 45); so no corner of such a
+triangle is a sample with all 4 neighbours sampled, and the triangle is
+Delaunay for the edge samples too. (Where four or more samples are cocircular, Delaunay triangulations are not
+unique and the two may pick different ones.) The nearest sample of an unsampled pixel is an edge sample as well:
+a step from any other sample towards the pixel, along the axis where it is farther, lands on a sample closer to it.
+
 Implementation note: the triangulation is scipy's (Qhull), but the triangles are rasterised here in numpy
 (scanline spans from exact integer edge tests, `_rasterise_triangles`) instead of querying
 `scipy.interpolate.LinearNDInterpolator`, which gives the same values (tested) but computes per-simplex
@@ -18,7 +31,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-from scipy import spatial
+from scipy import ndimage, spatial
 
 from lipjax.classical.nearest import nearest_fill
 from lipjax.inputs import check_frame
@@ -85,20 +98,36 @@ def _rasterise_triangles(points: np.ndarray, values: np.ndarray, simplices: np.n
     return dense
 
 
+def _edge_samples(sparse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(rows, cols) of the samples with an unsampled or out-of-frame pixel among their 4 neighbours: the only
+    corners of Delaunay triangles that hold unsampled pixels (module doc)."""
+    sampled = sparse > 0
+    return np.nonzero(sampled & ~ndimage.binary_erosion(sampled, border_value=0))  # the 4-neighbour cross
+
+
+def _delaunay(ys: np.ndarray, xs: np.ndarray) -> np.ndarray | None:
+    """(T, 3) indices into ys, xs of their Delaunay triangles; None for fewer than 3 or collinear points."""
+    if ys.size < 3:
+        return None
+    try:
+        return spatial.Delaunay(np.stack([ys, xs], axis=1).astype(np.float64)).simplices
+    except spatial.QhullError:  # all samples collinear: no 2-D triangulation exists
+        return None
+
+
 def linear_fill(sparse: np.ndarray) -> np.ndarray:
     """(H, W) float32 metres, 0 = no sample -> (H, W) float32 dense. Assumes at least one sample."""
-    ys, xs = np.nonzero(sparse > 0)
-    if ys.size < 3:
+    ys, xs = _edge_samples(sparse)
+    simplices = _delaunay(ys, xs)
+    if simplices is None:
         return nearest_fill(sparse)
-    points = np.stack([ys, xs], axis=1)
-    try:
-        simplices = spatial.Delaunay(points.astype(np.float64)).simplices
-    except spatial.QhullError:  # all samples collinear: no 2-D triangulation exists
-        return nearest_fill(sparse)
-    dense = _rasterise_triangles(points, sparse[ys, xs].astype(np.float64), simplices, sparse.shape)
+    dense = _rasterise_triangles(np.stack([ys, xs], axis=1), sparse[ys, xs].astype(np.float64), simplices,
+                                 sparse.shape)
     outside = np.isnan(dense)
     if outside.any():
         dense[outside] = nearest_fill(sparse)[outside]
+    sampled = sparse > 0
+    dense[sampled] = sparse[sampled]
     return dense.astype(np.float32)
 
 
@@ -110,7 +139,7 @@ def linear_fill_at(sparse: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np
     a few pixels of a large frame (lipjax.crosscheck's held-out samples) it skips the rasterisation and, without
     ties, the transform. Every pixel is tested against every sample and triangle, so above
     POINTWISE_PAIRS_PER_PIXEL pairs per pixel of the frame the full fill is computed and read instead."""
-    ys, xs = np.nonzero(sparse > 0)
+    ys, xs = _edge_samples(sparse)
     rows, cols = np.asarray(rows, np.int64), np.asarray(cols, np.int64)
     if rows.size * ys.size > POINTWISE_PAIRS_PER_PIXEL * sparse.size:
         return linear_fill(sparse)[rows, cols]
@@ -118,12 +147,7 @@ def linear_fill_at(sparse: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np
     values = sparse[ys, xs].astype(np.float64)
     out = values[np.argmin(d2, axis=1)]
     inside = np.zeros(rows.shape, bool)
-    simplices = None
-    if ys.size >= 3:
-        try:
-            simplices = spatial.Delaunay(np.stack([ys, xs], axis=1).astype(np.float64)).simplices
-        except spatial.QhullError:  # collinear samples: the full fill is the nearest fill
-            pass
+    simplices = _delaunay(ys, xs)  # None: the full fill is the nearest fill
     if simplices is not None:
         (y0, y1, y2), (x0, x1, x2) = ys[simplices].T, xs[simplices].T  # (T,) each
         den = (y1 - y2) * (x0 - x2) + (x2 - x1) * (y0 - y2)  # twice the signed area; 0: a sliver, skipped
@@ -140,6 +164,8 @@ def linear_fill_at(sparse: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np
     tied = ~inside & ((d2 == d2.min(axis=1, keepdims=True)).sum(axis=1) > 1)
     if tied.any():
         out[tied] = nearest_fill(sparse)[rows[tied], cols[tied]]
+    at_sample = sparse[rows, cols] > 0  # the full fill keeps every sample
+    out[at_sample] = sparse[rows, cols][at_sample]
     return out.astype(np.float32)
 
 
