@@ -1,4 +1,4 @@
-"""ms per frame through the default path at three frame sizes, with the machine's matmul rate in the same run.
+"""ms per frame through the default path on four inputs at three frame sizes, with the matmul rate of the same run.
 
 Run by hand (never a test):
 
@@ -6,7 +6,8 @@ Run by hand (never a test):
                                [--classical linear,nearest,ip_basic,colorization] [--repeats 5]
 
 Frames: synthetic test renders (the test split, never trained on) at 256x320 and 480x640 with 200 uniform points
-(a room) and at 352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
+(a room), at 480x640 as a depth camera sees it (dense depth with holes, `holes:0.2`: ~240,000 samples), and at
+352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
 through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its working size (lipjax.resolution),
 host fill, solver and resizes included, and on scattered samples the check against the linear fill
 (lipjax.crosscheck); "unchecked:NAME" is the same without that check (`--no-cross-check`). "default" is the model
@@ -31,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 from benchmarks.prox_speed import _median_ms, matmul_rate  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
+from lipjax.data.sampling import HolesSampler, LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import render  # noqa: E402
 from lipjax.inference import complete_frame, frame_size  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
@@ -40,6 +41,7 @@ from lipjax.onnx_export import export_onnx  # noqa: E402
 REFERENCE_GFLOPS = 195.0  # the rate the issues normalise frames/s to
 SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
          ("room 480x640, 200 pts", "indoor", 480, 640, UniformSampler(200)),
+         ("room 480x640, depth with holes", "indoor", 480, 640, HolesSampler(0.2)),
          ("street 352x1216, HDL-64", "outdoor", 352, 1216, LidarSampler.hdl64()))
 
 
