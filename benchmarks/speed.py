@@ -35,6 +35,7 @@ from benchmarks.prox_speed import _median_ms, matmul_rate  # noqa: E402
 from lipjax.data.sampling import HolesSampler, LidarSampler, UniformSampler  # noqa: E402
 from lipjax.data.synthetic import render  # noqa: E402
 from lipjax.inference import complete_frame, frame_size  # noqa: E402
+from lipjax.inputs import is_lidar_pattern  # noqa: E402
 from lipjax.methods import get_completer  # noqa: E402
 from lipjax.onnx_export import export_onnx  # noqa: E402
 
@@ -86,7 +87,7 @@ def _runner(name: str, rgb: np.ndarray, sparse: np.ndarray):
 
     path = os.path.join(tempfile.mkdtemp(prefix="lipjax-speed-"), "model.onnx")
     written = export_onnx(completer, path, height=sparse.shape[0], width=sparse.shape[1],
-                          samples=int((sparse > 0).sum()))
+                          samples=int((sparse > 0).sum()), scan_lines=is_lidar_pattern(sparse))
     assert written.working == (h, w), (written.working, (h, w))
     options = ort.SessionOptions()
     options.add_session_config_entry("session.intra_op.allow_spinning", "0")
