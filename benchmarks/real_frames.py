@@ -138,7 +138,7 @@ def main(argv=None) -> None:
 
 def _sweep_size(shape: tuple[int, int], spacing: float, target: float, scan_lines: bool) -> tuple[int, int]:
     """The working size with target spacing `target` (and the pixel cap of the pattern); >= 1e9: the native size."""
-    return tuple(shape) if target >= 1e9 else working_size(shape, spacing, target, scan_lines=scan_lines)
+    return tuple(shape) if target >= 1e9 else working_size(shape, spacing, target, capped=scan_lines)
 
 
 def sweep_table(rows: list[dict], plot: str | None) -> None:

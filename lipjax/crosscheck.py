@@ -18,7 +18,7 @@ there; it fires on some denser inputs, and on 5 of Table I's 100 frames); where 
 1.23 -> 0.96 x linear; with the lip-any of 2026-12-01, dense depth with holes: 1.08 -> 0.96) the output leans on
 the linear fill. Scan lines are not checked: random held-out returns lie a pixel from their neighbours on
 the same line, where every fill is right, so they say nothing of the gaps between the lines (and the LiDAR path
-keeps its 10 frames/s). Nor is dense input (over `lipjax.inputs.DENSE` samples per pixel: a depth camera's,
+keeps its 10 frames/s). Nor is dense input (over `lipjax.resolution.DENSE` samples per pixel: a depth camera's,
 stereo's), for the same reason: rule 49 of docs/design-notes.md measured rooms with holes 0.9297 x linear
 unchecked against 0.9488 checked, and the check cost two Delaunay fills of most of the frame's pixels. The
 held-out run uses the working size the default path gives the kept samples (`held_out_size`, rule 48 of
@@ -36,8 +36,8 @@ from collections.abc import Callable
 import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
-from lipjax.inputs import DENSE, is_lidar_pattern, quiet_checks
-from lipjax.resolution import sample_spacing_px, working_size
+from lipjax.inputs import is_lidar_pattern, quiet_checks
+from lipjax.resolution import DENSE, sample_spacing_px, working_size
 
 HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)

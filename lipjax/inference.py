@@ -23,7 +23,7 @@ from lipjax import crosscheck, model_io
 from lipjax.inputs import InputError, check_inputs, is_lidar_pattern  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
-from lipjax.resolution import MIN_MAX_SIDE_PX, max_side_size, sample_spacing_px, working_size
+from lipjax.resolution import MIN_MAX_SIDE_PX, is_capped, max_side_size, sample_spacing_px, working_size
 from lipjax.shipped import DEFAULT_MODEL, DEFAULT_MODELS
 from lipjax.spread import spread_on_host
 from lipjax.utils import warn_user
@@ -181,7 +181,8 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
     spacing = sample_spacing_px(sparse_m)
     if spacing == float("inf"):
         return shape
-    return working_size(shape, spacing, scan_lines=is_lidar_pattern(sparse_m))
+    return working_size(shape, spacing, capped=is_capped(int(np.count_nonzero(sparse_m > 0)), shape,
+                                                         is_lidar_pattern(sparse_m)))
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,

@@ -33,6 +33,7 @@ import numpy as np
 
 from lipjax.data.folder import KNOWN_DEPTH_SCALES
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.resolution import DENSE
 from lipjax.shipped import DEFAULT_MODELS, available
 from lipjax.utils import warn_user
 
@@ -47,8 +48,6 @@ OUTDOOR_MEDIAN_M = 12.0
 TRAINED_MIN_DENSITY = {"indoor": 100 / (256 * 320), "outdoor": 200 / (128 * 416)}
 # Indoor depth (<= 10 m) stored in millimetres but read with --depth-scale 256 reaches at most this.
 KINECT_AT_256_M = INDOOR_DEPTH_M * KNOWN_DEPTH_SCALES["nyu"] / KNOWN_DEPTH_SCALES["kitti"]
-# Samples per pixel above which a map is a depth camera's or stereo's, not LiDAR's (KITTI's raw scans: ~5 %).
-DENSE = 0.3
 
 
 class InputError(ValueError):

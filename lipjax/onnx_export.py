@@ -63,7 +63,7 @@ from lipjax.fill import jump_flood_nearest
 from lipjax.inference import MIRROR_AVERAGE, SPREAD_RESIDUALS, Completer
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
-from lipjax.resolution import working_size
+from lipjax.resolution import DENSE, is_capped, working_size
 from lipjax.spread import spread_residuals, spread_sigmas_px
 
 INPUT_NAMES, OUTPUT_NAMES = ("rgb", "sparse"), ("depth",)
@@ -80,13 +80,20 @@ def export_working_size(height: int, width: int, samples: int, scan_lines: bool 
     LiDAR scan lines or scattered."""
     if not 1 <= samples <= height * width:
         raise ValueError(f"--samples {samples}: give the number of depth samples per frame, 1 to {height * width}")
-    return working_size((height, width), math.sqrt(height * width / samples), scan_lines=scan_lines)
+    return working_size((height, width), math.sqrt(height * width / samples),
+                        capped=is_capped(samples, (height, width), scan_lines))
 
 
 def samples_interval(height: int, width: int, samples: int, scan_lines: bool = True) -> tuple[int, int]:
     """(lo, hi): the sample counts n for which lipjax.complete picks the same working size as for `samples` (of
-    the same pattern). The size never shrinks as n grows, so they are an interval, found by bisection."""
+    the same pattern). Scan lines: the size never shrinks as n grows, so they are an interval, found by bisection.
+    Scattered samples: the same within each of two ranges, up to DENSE samples a pixel and beyond (dense maps, capped
+    at MAX_WORKING_PIXELS, lipjax.resolution.is_capped); the interval stays inside the range of `samples`."""
     size, n_max = export_working_size(height, width, samples, scan_lines), height * width
+    lo_n, hi_n = 1, n_max
+    if not scan_lines:
+        dense_from = math.floor(DENSE * n_max) + 1  # the fewest samples of a dense map
+        lo_n, hi_n = (dense_from, n_max) if samples >= dense_from else (1, min(n_max, dense_from - 1))
 
     def first(lo: int, hi: int, is_past) -> int:  # the smallest n in [lo, hi] with is_past(n); is_past(hi) holds
         while lo < hi:
@@ -97,8 +104,8 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
     def same(n: int) -> bool:
         return export_working_size(height, width, n, scan_lines) == size
 
-    low = first(1, samples, same)
-    high = first(samples, n_max + 1, lambda n: n > n_max or not same(n)) - 1
+    low = first(lo_n, samples, same)
+    high = first(samples, hi_n + 1, lambda n: n > hi_n or not same(n)) - 1
     return low, high
 
 

@@ -8,8 +8,8 @@ training saw, and only there:
 
     spacing_px = sqrt(H W / n)                                n samples on an H x W frame
     s          = min(1, TARGET_SPACING_PX / spacing_px,       the working scale (never above the frame's size),
-                     sqrt(MAX_WORKING_PIXELS / (H W)))        and, for LiDAR scan lines only, at most
-                                                              MAX_WORKING_PIXELS pixels
+                     sqrt(MAX_WORKING_PIXELS / (H W)))        and, for LiDAR scan lines and dense maps
+                                                              only (`capped`), at most MAX_WORKING_PIXELS pixels
     (h, w)     = round(s H), round(s W), the shorter side at least MIN_WORKING_SIDE_PX
 
 Sparse inputs (200 points on 480x640: 39 px apart) run at 0.41x (196x261). Dense scattered ones (1,000 points or
@@ -18,9 +18,12 @@ size. A LiDAR scan (64 beams, ~5 px apart on a KITTI frame) also lies closer, bu
 below full size (0.38x, 132x455): the prox's receptive field and its training frames (128x160 crops) cover a fixed
 number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow slice of the street
 (the rows between beams, the sky above the top beam). Scattered samples carry no such structure, and capping them
-only throws their detail away. The data-consistency step and the output stay at full resolution
-(`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every measured pixel is set back to its
-measured value (the x-update with rho -> 0 at m = 1).
+only throws their detail away. Dense maps (over DENSE samples a pixel: a depth camera's, stereo's,
+with holes) are capped as scan lines are (rule 50 of docs/design-notes.md: 8 synthetic 480x640 rooms with holes,
+0.9663 x linear at full size, 0.7508 at 212x283; the prox learned to fill gaps of a few working pixels, and a
+camera's holes are tens of pixels wide; every sample is set back at full size). The data-consistency step and
+the output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every
+measured pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
 
 The constants were chosen on synthetic renders larger than the training frames (`python
 benchmarks/working_resolution.py --model lip-any --frames 6`, geometric-mean RMSE ratio to the full-size linear fill
@@ -41,6 +44,8 @@ import math
 import numpy as np
 
 TARGET_SPACING_PX = 16.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
+# Samples per pixel above which a map is a depth camera's or stereo's, not LiDAR's (KITTI's raw scans: ~5 %): dense.
+DENSE = 0.3
 MAX_WORKING_PIXELS = 60_000  # the largest working size of LiDAR scan lines, pixels (see the module doc)
 MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
 MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
@@ -59,18 +64,18 @@ def sample_spacing_px(sparse_m: np.ndarray) -> float:
 
 def working_size(shape: tuple[int, int], spacing_px: float, target_spacing_px: float = TARGET_SPACING_PX,
                  max_pixels: float | None = None, min_side_px: int = MIN_WORKING_SIDE_PX, *,
-                 scan_lines: bool = False) -> tuple[int, int]:
+                 capped: bool = False) -> tuple[int, int]:
     """(h, w) at which a learned prox runs on a frame of `shape` (H, W) whose samples lie `spacing_px` apart.
 
-    `max_pixels` None: MAX_WORKING_PIXELS for LiDAR scan lines (`scan_lines`, lipjax.inputs.is_lidar_pattern),
-    no cap for scattered samples. The frame's own size when it is already at most that coarse
+    `max_pixels` None: MAX_WORKING_PIXELS for LiDAR scan lines and dense maps (`capped`: `is_capped`), no cap for
+    other scattered samples. The frame's own size when it is already at most that coarse
     (s >= MIN_SCALE_CHANGE) or has no samples.
     """
     big_h, big_w = shape
     if not spacing_px > 0:
         raise ValueError(f"spacing_px must be > 0, got {spacing_px}")
     if max_pixels is None:
-        max_pixels = MAX_WORKING_PIXELS if scan_lines else math.inf
+        max_pixels = MAX_WORKING_PIXELS if capped else math.inf
     s = min(1.0, target_spacing_px / spacing_px, math.sqrt(max_pixels / (big_h * big_w)))
     s = max(s, min(1.0, min_side_px / min(big_h, big_w)))
     if s >= MIN_SCALE_CHANGE:
@@ -85,3 +90,9 @@ def max_side_size(shape: tuple[int, int], max_side: int) -> tuple[int, int]:
         return big_h, big_w
     s = max_side / max(big_h, big_w)
     return max(1, round(big_h * s)), max(1, round(big_w * s))
+
+
+def is_capped(samples: int, shape: tuple[int, int], scan_lines: bool) -> bool:
+    """Whether `working_size` caps a frame of `shape` with `samples` samples at MAX_WORKING_PIXELS: LiDAR scan lines
+    (lipjax.inputs.is_lidar_pattern), or a dense map of over DENSE samples a pixel (rule 50, module doc)."""
+    return scan_lines or samples > DENSE * shape[0] * shape[1]

@@ -168,7 +168,7 @@ def test_a_frame_that_warns_warns_once_from_the_same_line():
 def test_dense_input_is_not_checked():
     """Over DENSE samples per pixel (a depth camera's map with holes) the held-out samples lie a pixel from kept
     ones, where every fill is right: the default path runs the model once, as with cross_check=False."""
-    from lipjax.inputs import DENSE
+    from lipjax.resolution import DENSE
 
     depth = _plane()
     sparse = _scattered(depth, int(0.9 * depth.size))

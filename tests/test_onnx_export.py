@@ -14,7 +14,7 @@ from lipjax.inputs import is_lidar_pattern
 from lipjax.model import LIPConfig
 from lipjax.onnx_export import (export_onnx, export_working_size, inference_graph, nearest_twin, samples_interval)
 from lipjax.priors.guided import PRESETS
-from lipjax.resolution import MAX_WORKING_PIXELS, working_size
+from lipjax.resolution import DENSE, MAX_WORKING_PIXELS, working_size
 
 from helpers import perturbed
 
@@ -66,15 +66,19 @@ def test_an_untranslated_primitive_is_a_one_line_error():
 
 def test_the_working_size_is_fixed_from_the_sample_count_for_an_interval_of_counts():
     size = export_working_size(352, 1216, 20000)  # a 64-beam scan: the scan lines' pixel cap decides
-    assert size == working_size((352, 1216), math.sqrt(352 * 1216 / 20000), scan_lines=True)
+    assert size == working_size((352, 1216), math.sqrt(352 * 1216 / 20000), capped=True)
     assert size[0] * size[1] == pytest.approx(MAX_WORKING_PIXELS, rel=0.01)
     lo, hi = samples_interval(352, 1216, 20000)
     assert hi == 352 * 1216 and 1 < lo < 20000 and export_working_size(352, 1216, lo) == size
     assert export_working_size(352, 1216, lo - 1) != size
-    # as many scattered points: no cap, the full size, for every count whose spacing is under about 22 px
+    # as many scattered points: no cap, the full size, for every count whose spacing is under about 22 px, up to
+    # DENSE samples a pixel; a dense map beyond that is capped as scan lines are (rule 50)
     assert export_working_size(352, 1216, 20000, scan_lines=False) == (352, 1216)
     lo, hi = samples_interval(352, 1216, 20000, scan_lines=False)
-    assert hi == 352 * 1216 and export_working_size(352, 1216, lo - 1, scan_lines=False) != (352, 1216)
+    assert hi == math.floor(DENSE * 352 * 1216)
+    assert export_working_size(352, 1216, lo - 1, scan_lines=False) != (352, 1216)
+    assert export_working_size(352, 1216, hi + 1, scan_lines=False) == size
+    assert samples_interval(352, 1216, hi + 1, scan_lines=False) == (hi + 1, 352 * 1216)
     lo, hi = samples_interval(128, 160, 10)
     assert export_working_size(128, 160, 10) == (64, 80)
     assert all(export_working_size(128, 160, n) == (64, 80) for n in (lo, hi))

@@ -10,6 +10,7 @@ from lipjax.classical.interpolate import linear_fill
 from lipjax.inputs import is_lidar_pattern
 from lipjax.methods import get_completer
 from lipjax.resolution import (
+    DENSE,
     MAX_WORKING_PIXELS,
     MIN_SCALE_CHANGE,
     MIN_WORKING_SIDE_PX,
@@ -44,9 +45,9 @@ def test_working_size_puts_the_samples_at_the_target_spacing():
 
 
 def test_dense_samples_and_small_frames_run_at_full_size():
-    assert working_size((200, 280), 4.7, scan_lines=True) == (200, 280)  # a dense scan under the pixel cap
+    assert working_size((200, 280), 4.7, capped=True) == (200, 280)  # a dense scan under the pixel cap
     # a KITTI-size scan: the pixel cap alone sets the scale
-    h, w = working_size((352, 1216), 4.7, scan_lines=True)
+    h, w = working_size((352, 1216), 4.7, capped=True)
     assert h * w == pytest.approx(MAX_WORKING_PIXELS, rel=0.01) and w / h == pytest.approx(1216 / 352, rel=0.01)
     # as many scattered samples: no cap, full size
     assert working_size((352, 1216), 4.7) == (352, 1216)
@@ -98,9 +99,15 @@ def test_frame_size_follows_the_samples_for_learned_models_only():
     assert is_lidar_pattern(lines)
     h, w = inference.frame_size(model, lines)
     assert h * w <= MAX_WORKING_PIXELS * 1.01 and (h, w) == working_size((352, 1216), sample_spacing_px(lines),
-                                                                            scan_lines=True)
+                                                                            capped=True)
     scattered = _sparse(352, 1216, int(np.count_nonzero(lines)))
     assert not is_lidar_pattern(scattered) and inference.frame_size(model, scattered) == (352, 1216)
+    # a dense map (a depth camera's, over DENSE samples a pixel) is capped as scan lines are; just below, full size
+    n_dense = int(DENSE * 240 * 320)
+    assert inference.frame_size(model, _sparse(240, 320, n_dense)) == (240, 320)
+    h, w = inference.frame_size(model, _sparse(240, 320, n_dense + 1))
+    s = (MAX_WORKING_PIXELS / (240 * 320)) ** 0.5  # 0.88: under MIN_SCALE_CHANGE, so the frame is resized
+    assert (h, w) == (round(240 * s), round(320 * s)) == (212, 283)
     assert inference.frame_size(get_completer("linear"), sparse) == (240, 320)
     assert inference.frame_size(model, sparse, max_side=160) == (120, 160)
     with pytest.raises(inference.InputError, match="max_side 3"):
