@@ -25,8 +25,8 @@ held-out run uses the working size the default path gives the kept samples (`hel
 docs/design-notes.md): the model sees them as far apart as it was trained to, in 0.8x
 the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames only, by a rule
 fixed before measuring (docs/design-notes.md, "A check against the linear fill"). Costs a second run of the
-model (two more with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires (on dense
-inputs, such as depth with holes, the Delaunay fills take most of the time); `cross_check=False`
+model (two more with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires;
+`cross_check=False`
 (lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
 """
 from __future__ import annotations
