@@ -8,9 +8,9 @@ is the nearest-neighbour fill.
 Only the samples on the edge of the sampled region are triangulated (`_edge_samples`: those with an unsampled or
 out-of-frame pixel among their 4 neighbours), which makes dense depth with holes (a depth camera's, stereo's) fast
 (a synthetic 480x640 room with holes: 240,474 samples, 7,863 of them on the edge; 22 s -> 0.7-0.9 s beside a
-training run) and leaves scattered samples and scan lines as they were (every such sample is on the edge). The fill
-at the unsampled pixels is still a Delaunay linear fill of all the samples: a Delaunay triangle that holds an
-unsampled lattice pixel other than its corners has an edge of length >= 2 (a lattice triangle with edges of 1 and
+training run) and leaves scattered samples and scan lines as they were (nearly every such sample is on the edge).
+The fill at the unsampled pixels is still a Delaunay linear fill of all the samples: a Delaunay triangle that holds
+an unsampled lattice pixel other than its corners has an edge of length >= 2 (a lattice triangle with edges of 1 and
 sqrt(2) holds none), so a circumradius R >= 1; a circle through a sample of radius R > 1/sqrt(2) has one of its 4
 neighbours strictly inside (the one within 45 degrees of the way to the centre: 1 < 2 R cos 45); so no corner of
 such a triangle is a sample with all 4 neighbours sampled, and the triangle is Delaunay for the edge samples too.
