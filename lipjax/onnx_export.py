@@ -18,7 +18,8 @@ than the one lipjax trains with, see that module):
      per frame in LiDAR scan lines (default) or scattered (`scan_lines=False`, --scattered), `export_working_size`.
      `lipjax.complete` picks it per frame from the frame's own sample count n and pattern; it is the same (h, w)
      for every n in an interval (`samples_interval`), printed and stored in the metadata. For scan lines at
-     352x1216 and 480x640 that interval is every n from 234 up: the pixel cap MAX_WORKING_PIXELS decides.
+     352x1216 and 480x640 that interval is every n from 234 up: the pixel cap MAX_WORKING_PIXELS decides; for
+     scattered samples it ends at DENSE samples a pixel, beyond which a dense map is capped as scan lines are.
   2. rgb -> (h, w) as cv2.resize(INTER_AREA) and its uint8 rounding; sparse -> (h, w) by reprojection, the
      nearest depth winning (lipjax.resample: gathers with constant tables, mins and sums).
   3. z0, the initial fill, in the graph: the nearest-sample fill by jump flooding (lipjax.fill.jump_flood_nearest),
