@@ -37,7 +37,7 @@ import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
 from lipjax.inputs import is_lidar_pattern, quiet_checks
-from lipjax.resolution import DENSE, sample_spacing_px, working_size
+from lipjax.resolution import dense_from, sample_spacing_px, working_size
 
 HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
@@ -49,7 +49,7 @@ def applies(sparse_m: np.ndarray) -> bool:
     """Whether a (H, W) sparse map (metres, 0 = none) is checked: >= MIN_SAMPLES samples, at most DENSE per pixel,
     not LiDAR scan lines."""
     n = int(np.count_nonzero(sparse_m > 0))
-    return MIN_SAMPLES <= n <= DENSE * sparse_m.size and not is_lidar_pattern(sparse_m)
+    return MIN_SAMPLES <= n < dense_from(sparse_m.size) and not is_lidar_pattern(sparse_m)
 
 
 def hold_out(sparse_m: np.ndarray, fraction: float = HOLDOUT_FRACTION, seed: int = SEED):

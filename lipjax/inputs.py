@@ -33,7 +33,7 @@ import numpy as np
 
 from lipjax.data.folder import KNOWN_DEPTH_SCALES
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
-from lipjax.resolution import DENSE
+from lipjax.resolution import dense_from
 from lipjax.shipped import DEFAULT_MODELS, available
 from lipjax.utils import warn_user
 
@@ -194,7 +194,7 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
     elif not lidar and samples.max() <= INDOOR_DEPTH_M:
         _warn(f"every sample within {INDOOR_DEPTH_M:g} m and no LiDAR scan lines: looks like indoor data, use "
               f"{_other_model(name, 'indoor')}")
-    elif not lidar and density > DENSE and samples.max() <= KINECT_AT_256_M:
+    elif not lidar and samples.size >= dense_from(sparse.size) and samples.max() <= KINECT_AT_256_M:
         _warn(f"a dense depth map within {KINECT_AT_256_M:.0f} m: a millimetre PNG (Kinect, NYU) read with "
               f"--depth-scale 256 (use 1000), or indoor data (use {_other_model(name, 'indoor')})?")
     if both_scenes:  # the sparser of the two scenes' inputs

@@ -64,7 +64,7 @@ from lipjax.fill import jump_flood_nearest
 from lipjax.inference import MIRROR_AVERAGE, SPREAD_RESIDUALS, Completer
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
-from lipjax.resolution import DENSE, is_capped, working_size
+from lipjax.resolution import dense_from, is_capped, working_size
 from lipjax.spread import spread_residuals, spread_sigmas_px
 
 INPUT_NAMES, OUTPUT_NAMES = ("rgb", "sparse"), ("depth",)
@@ -93,8 +93,8 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
     size, n_max = export_working_size(height, width, samples, scan_lines), height * width
     lo_n, hi_n = 1, n_max
     if not scan_lines:
-        dense_from = math.floor(DENSE * n_max) + 1  # the fewest samples of a dense map
-        lo_n, hi_n = (dense_from, n_max) if samples >= dense_from else (1, min(n_max, dense_from - 1))
+        first_dense = dense_from(n_max)  # the fewest samples of a dense map
+        lo_n, hi_n = (first_dense, n_max) if samples >= first_dense else (1, min(n_max, first_dense - 1))
 
     def first(lo: int, hi: int, is_past) -> int:  # the smallest n in [lo, hi] with is_past(n); is_past(hi) holds
         while lo < hi:

@@ -92,7 +92,13 @@ def max_side_size(shape: tuple[int, int], max_side: int) -> tuple[int, int]:
     return max(1, round(big_h * s)), max(1, round(big_w * s))
 
 
+def dense_from(pixels: int) -> int:
+    """The fewest samples that make a map of `pixels` pixels dense (over DENSE samples a pixel); every test of
+    density in the library goes through here, so that all of them agree at the boundary."""
+    return math.floor(DENSE * pixels) + 1
+
+
 def is_capped(samples: int, shape: tuple[int, int], scan_lines: bool) -> bool:
     """Whether `working_size` caps a frame of `shape` with `samples` samples at MAX_WORKING_PIXELS: LiDAR scan lines
-    (lipjax.inputs.is_lidar_pattern), or a dense map of over DENSE samples a pixel (rule 50, module doc)."""
-    return scan_lines or samples > DENSE * shape[0] * shape[1]
+    (lipjax.inputs.is_lidar_pattern), or a dense map (`dense_from`; rule 50, module doc)."""
+    return scan_lines or samples >= dense_from(shape[0] * shape[1])

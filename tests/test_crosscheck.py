@@ -179,3 +179,16 @@ def test_dense_input_is_not_checked():
     rgb = np.full(depth.shape + (3,), 128, np.uint8)
     np.testing.assert_array_equal(complete_at(model, rgb, sparse, depth.shape),
                                   complete_at(model, rgb, sparse, depth.shape, cross_check=False))
+
+
+@pytest.mark.parametrize("shape", [(72, 1040), (48, 64)])
+def test_the_check_and_the_working_size_agree_on_what_is_dense(shape):
+    """At the DENSE boundary (one definition: lipjax.resolution.dense_from) a map is either checked at its own
+    working size or capped as a dense map, never both ((0.3 * H) * W and 0.3 * (H * W) round differently on 72x1040,
+    which split the two before)."""
+    from lipjax.resolution import dense_from, is_capped
+
+    n = dense_from(shape[0] * shape[1])
+    for count, dense in ((n - 1, False), (n, True)):
+        sparse = _scattered(np.full(shape, 3.0, np.float32), count)
+        assert crosscheck.applies(sparse) is not dense and is_capped(count, shape, False) is dense

@@ -14,9 +14,11 @@ an unsampled lattice pixel other than its corners has an edge of length >= 2 (a 
 sqrt(2) holds none), so a circumradius R >= 1; a circle through a sample of radius R > 1/sqrt(2) has one of its 4
 neighbours strictly inside (the one within 45 degrees of the way to the centre: 1 < 2 R cos 45); so no corner of
 such a triangle is a sample with all 4 neighbours sampled, and the triangle is Delaunay for the edge samples too.
-(Where four or more samples are cocircular, Delaunay triangulations are not unique and the two may pick different
-ones.) The nearest sample of an unsampled pixel is an edge sample as well: a step from any other sample towards the
-pixel, along the axis where it is farther, lands on a sample closer to it.
+Conversely, every corner of all the samples' hull is an edge sample (its neighbour beyond the hull is unsampled), so
+both triangulations tile the same hull and every triangle of the edge samples that holds an unsampled pixel is one
+of all the samples'. (Where four or more samples are cocircular, Delaunay triangulations are not unique and the two
+may pick different ones.) The nearest sample of an unsampled pixel is an edge sample as well: a step from any other
+sample towards the pixel, along the axis where it is farther, lands on a sample closer to it.
 
 Implementation note: the triangulation is scipy's (Qhull), but the triangles are rasterised here in numpy
 (scanline spans from exact integer edge tests, `_rasterise_triangles`) instead of querying
