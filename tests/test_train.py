@@ -97,6 +97,22 @@ def test_export_averages_the_newest_checkpoints(straight_run, tmp_path):
         run(CONFIG, workdir, export=tmp_path / "avg9", export_only=True, average=9, progress=False)
 
 
+def test_an_export_from_a_workdir_needs_the_runs_own_config(straight_run, tmp_path):
+    """A workdir records what its export's budget and data record come from (run.json); exporting it with another
+    init_from or seed is a one-line error naming both values, not a model with a wrong images_seen."""
+    from lipjax.train.run import run
+
+    workdir, _ = straight_run
+    assert json.loads((workdir / loop.RUN_FILE).read_text()) == loop.run_record(CONFIG)
+    loop.export(CONFIG, init_state(CONFIG), tmp_path / "start")
+    for other, named in ((dataclasses.replace(CONFIG, init_from=str(tmp_path / "start")), "init_from=None"),
+                         (dataclasses.replace(CONFIG, seed=7), "seed=0")):
+        with pytest.raises(ValueError, match=f"trained with {named}, this config has") as error:
+            run(other, workdir, export=tmp_path / "wrong", export_only=True, progress=False)
+        assert "\n" not in str(error.value)
+    assert not (tmp_path / "wrong.json").exists()
+
+
 def test_a_soup_is_the_mean_of_models_of_one_chain_with_the_newest_models_budget(straight_run, tmp_path):
     """`soup` saves the element-wise mean of G's parameters over models of one chain of warm starts, validated on
     the config's validation set, with the newest model's budget; a model from outside the chain, or of another

@@ -3,10 +3,10 @@
     train(config, workdir)   # resumes from workdir/checkpoints if present
 
 Layout of `workdir`: checkpoints/<step>/ (orbax), metrics.jsonl (one JSON object per logged step or evaluation),
-config.txt (the config's repr). A run writes nothing outside its workdir. Resume is exact: the state holds
-parameters, both optimiser states, the step and the RNG key; the data position is the step (batch s is a pure
-function of (seed, s), see lipjax.data.pipeline), recorded in each checkpoint's metadata with the loader's
-grain iterator state, and checked on resume.
+config.txt (the config's repr) and run.json (`run_record`, which an export from the workdir checks). A run writes
+nothing outside its workdir. Resume is exact: the state holds parameters, both optimiser states, the step and the
+RNG key; the data position is the step (batch s is a pure function of (seed, s), see lipjax.data.pipeline),
+recorded in each checkpoint's metadata with the loader's grain iterator state, and checked on resume.
 """
 from __future__ import annotations
 
@@ -224,6 +224,7 @@ def train(
     workdir = pathlib.Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     (workdir / "config.txt").write_text(repr(config) + "\n")
+    (workdir / RUN_FILE).write_text(json.dumps(run_record(config)) + "\n")
     mesh = make_data_mesh() if mesh is None else mesh
     process_index = jax.process_index() if process_index is None else process_index
     process_count = jax.process_count() if process_count is None else process_count
@@ -286,6 +287,32 @@ def data_streams(metadata: dict) -> list[dict]:
     if "train_config" in metadata:
         return [{"train_config": metadata["train_config"], "seed": 0, "steps": None}]
     return []
+
+
+RUN_FILE = "run.json"  # in a workdir: run_record of the config that trained it
+
+
+def run_record(config: TrainConfig) -> dict:
+    """What of `config` an export's budget and data record (`export`: images_seen, data_streams) are made of: the
+    model it started from, its name, seed, batch size and data settings, as JSON values. `train` writes it into the
+    workdir (RUN_FILE), so that an export from that workdir can check that it is given the run's own config."""
+    return json.loads(json.dumps({"init_from": config.init_from, "train_config": config.name, "seed": config.seed,
+                                  "batch_size": config.batch_size, "data": data_recipe(config.data)}))
+
+
+def check_same_run(config: TrainConfig, workdir: str | os.PathLike) -> None:
+    """One-line ValueError unless `config` has the run record of the config that trained `workdir` (RUN_FILE; runs
+    that started before it was written are not checked): exported with another init_from or seed, a model would
+    carry a wrong images_seen and data_streams."""
+    path = pathlib.Path(workdir) / RUN_FILE
+    if not path.exists():
+        return
+    recorded, given = json.loads(path.read_text()), run_record(config)
+    differ = [key for key in given if recorded.get(key) != given[key]]
+    if differ:
+        raise ValueError(f"{workdir} was trained with {', '.join(f'{k}={recorded.get(k)!r}' for k in differ)}, "
+                         f"this config has {', '.join(f'{k}={given[k]!r}' for k in differ)}: give the run's own "
+                         "--set flags to export it (its metadata, images_seen and data_streams, come from them)")
 
 
 def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,

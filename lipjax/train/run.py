@@ -26,7 +26,8 @@ from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
 from lipjax.train.folder import check_frames, default_init, folder_config
-from lipjax.train.loop import data_streams, evaluate_params, export as export_model, train, validation_batches
+from lipjax.train.loop import check_same_run, data_streams, evaluate_params, export as export_model, train
+from lipjax.train.loop import validation_batches
 from lipjax.train.state import init_state
 
 
@@ -115,9 +116,10 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     Before training, the folder of `export` must be writable (`check_writable`) and a folder source's frames
     readable (lipjax.train.folder.check_frames).
 
-    export_only: skip training and export the latest checkpoint. average: validate and export the mean
-    parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
-    metadata as `checkpoints`). validate_start: validate the starting parameters too (lipjax.train.loop.train);
+    export_only: skip training and export the latest checkpoint (`config` must be the run's own:
+    lipjax.train.loop.check_same_run). average: validate and export the mean parameters of the newest `average`
+    checkpoints instead (`averaged_params`; their steps go into the model's metadata as `checkpoints`).
+    validate_start: validate the starting parameters too (lipjax.train.loop.train);
     the last line then gives both scores. Returns the validation metrics (metres).
     """
     workdir = pathlib.Path(workdir)
@@ -128,6 +130,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     if config.data.source == "folder" and not export_only:
         check_frames(config.data)
     if export_only:
+        check_same_run(config, workdir)
         manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
         if manager.latest_step() is None:
             raise FileNotFoundError(f"no checkpoint in {manager.directory} to export; "
