@@ -26,8 +26,7 @@ docs/design-notes.md): the model sees them as far apart as it was trained to, in
 the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames only, by a rule
 fixed before measuring (docs/design-notes.md, "A check against the linear fill"). Costs a second run of the
 model (two more with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires;
-`cross_check=False`
-(lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
+`cross_check=False` (lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
 """
 from __future__ import annotations
 
