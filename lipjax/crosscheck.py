@@ -42,6 +42,7 @@ HOLDOUT_FRACTION = 0.2  # share of the samples held out of the model's input
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
 P_VALUE = 0.05  # the sign test's level: the model gives way only on this much evidence
 SEED = 0  # which samples are held out: fixed, so that a frame always gives the same depth
+FOLDS = 1  # 1: one held-out share; k > 1: k disjoint folds that hold out every sample once
 
 
 def applies(sparse_m: np.ndarray) -> bool:
@@ -59,6 +60,18 @@ def hold_out(sparse_m: np.ndarray, fraction: float = HOLDOUT_FRACTION, seed: int
     kept = np.array(sparse_m, np.float32)
     kept[rows[held], cols[held]] = 0.0
     return kept, rows[held], cols[held]
+
+
+def fold_out(sparse_m: np.ndarray, folds: int, seed: int = SEED):
+    """[(kept, rows, cols)] for `folds` disjoint folds of the samples (a seeded permutation cut in `folds` parts): each
+    fold's samples set to 0 in its kept map, every sample held out once."""
+    rows, cols = np.nonzero(sparse_m > 0)
+    out = []
+    for held in np.array_split(np.random.default_rng(seed).permutation(rows.size), folds):
+        kept = np.array(sparse_m, np.float32)
+        kept[rows[held], cols[held]] = 0.0
+        out.append((kept, rows[held], cols[held]))
+    return out
 
 
 def held_out_size(size: tuple[int, int], kept_m: np.ndarray) -> tuple[int, int]:
@@ -87,10 +100,13 @@ def cross_checked(estimate: Callable[[np.ndarray], np.ndarray], sparse_m: np.nda
     gives (z, 1.0)."""
     if not applies(sparse_m):
         return z, 1.0
-    kept, rows, cols = hold_out(sparse_m)
-    with quiet_checks():  # the input checks already spoke about the user's frame, not this one
-        z_kept = estimate(kept)
-    w = blend_weight(sparse_m[rows, cols], z_kept[rows, cols], linear_fill_at(kept, rows, cols))
+    parts = [hold_out(sparse_m)] if FOLDS == 1 else fold_out(sparse_m, FOLDS)
+    y, x_m, x_l = [], [], []
+    for kept, rows, cols in parts:
+        with quiet_checks():  # the input checks already spoke about the user's frame, not this one
+            z_kept = estimate(kept)
+        y.append(sparse_m[rows, cols]), x_m.append(z_kept[rows, cols]), x_l.append(linear_fill_at(kept, rows, cols))
+    w = blend_weight(np.concatenate(y), np.concatenate(x_m), np.concatenate(x_l), P_VALUE)
     if w == 1.0:
         return z, w
     return (w * z + (1.0 - w) * linear_fill(sparse_m)).astype(np.float32), w

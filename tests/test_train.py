@@ -113,6 +113,23 @@ def test_an_export_from_a_workdir_needs_the_runs_own_config(straight_run, tmp_pa
     assert not (tmp_path / "wrong.json").exists()
 
 
+def test_a_resume_needs_the_runs_own_config(straight_run, tmp_path):
+    """Resuming a workdir with another seed is a one-line error before any step, and the run's record stays: its
+    checkpoints read the recorded seed's data, and a model exported from it would carry a wrong data record."""
+    import shutil
+
+    workdir = tmp_path / "copy"
+    shutil.copytree(straight_run[0], workdir)
+    record = (workdir / loop.RUN_FILE).read_text()
+    with pytest.raises(ValueError, match="trained with seed=0, this config has seed=7") as error:
+        loop.train(dataclasses.replace(CONFIG, seed=7, adv_steps=CONFIG.adv_steps + 2), workdir, progress=False)
+    assert "\n" not in str(error.value)
+    assert (workdir / loop.RUN_FILE).read_text() == record
+    manager = CheckpointManager(workdir / "checkpoints", keep=CONFIG.keep_checkpoints)
+    assert manager.latest_step() == CONFIG.total_steps
+    manager.close()
+
+
 def test_a_soup_is_the_mean_of_models_of_one_chain_with_the_newest_models_budget(straight_run, tmp_path):
     """`soup` saves the element-wise mean of G's parameters over models of one chain of warm starts, validated on
     the config's validation set, with the newest model's budget; a model from outside the chain, or of another

@@ -3,10 +3,11 @@
     train(config, workdir)   # resumes from workdir/checkpoints if present
 
 Layout of `workdir`: checkpoints/<step>/ (orbax), metrics.jsonl (one JSON object per logged step or evaluation),
-config.txt (the config's repr) and run.json (`run_record`, which an export from the workdir checks). A run writes
-nothing outside its workdir. Resume is exact: the state holds parameters, both optimiser states, the step and the
-RNG key; the data position is the step (batch s is a pure function of (seed, s), see lipjax.data.pipeline),
-recorded in each checkpoint's metadata with the loader's grain iterator state, and checked on resume.
+config.txt (the config's repr) and run.json (`run_record`, which a resume and an export of the workdir check). A
+run writes nothing outside its workdir. Resume is exact: the state holds parameters, both optimiser states, the
+step and the RNG key; the data position is the step (batch s is a pure function of (seed, s), see
+lipjax.data.pipeline), recorded in each checkpoint's metadata with the loader's grain iterator state, and checked
+on resume.
 """
 from __future__ import annotations
 
@@ -223,8 +224,6 @@ def train(
     """
     workdir = pathlib.Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
-    (workdir / "config.txt").write_text(repr(config) + "\n")
-    (workdir / RUN_FILE).write_text(json.dumps(run_record(config)) + "\n")
     mesh = make_data_mesh() if mesh is None else mesh
     process_index = jax.process_index() if process_index is None else process_index
     process_count = jax.process_count() if process_count is None else process_count
@@ -232,6 +231,14 @@ def train(
 
     val = validation_batches(config) if config.eval_every else []  # a missing data set fails before the model init
     manager = CheckpointManager(workdir / "checkpoints", keep=config.keep_checkpoints)
+    if manager.latest_step() is not None:  # a resume: the steps so far read the recorded config's data
+        try:
+            check_same_run(config, workdir)
+        except ValueError:
+            manager.close()
+            raise
+    (workdir / "config.txt").write_text(repr(config) + "\n")
+    (workdir / RUN_FILE).write_text(json.dumps(run_record(config)) + "\n")
     state, meta = _resume(config, manager, is_main)
     start = int(state.step)
     rng = jax.random.wrap_key_data(np.asarray(state.rng))
@@ -295,15 +302,16 @@ RUN_FILE = "run.json"  # in a workdir: run_record of the config that trained it
 def run_record(config: TrainConfig) -> dict:
     """What of `config` an export's budget and data record (`export`: images_seen, data_streams) are made of: the
     model it started from, its name, seed, batch size and data settings, as JSON values. `train` writes it into the
-    workdir (RUN_FILE), so that an export from that workdir can check that it is given the run's own config."""
+    workdir (RUN_FILE), so that a resume or an export of that workdir can check that it is given the run's own
+    config."""
     return json.loads(json.dumps({"init_from": config.init_from, "train_config": config.name, "seed": config.seed,
                                   "batch_size": config.batch_size, "data": data_recipe(config.data)}))
 
 
 def check_same_run(config: TrainConfig, workdir: str | os.PathLike) -> None:
     """One-line ValueError unless `config` has the run record of the config that trained `workdir` (RUN_FILE; runs
-    that started before it was written are not checked): exported with another init_from or seed, a model would
-    carry a wrong images_seen and data_streams."""
+    that started before it was written are not checked): resumed or exported with another init_from or seed, a
+    model would carry a wrong images_seen and data_streams. `train` checks a resume, `run` an export."""
     path = pathlib.Path(workdir) / RUN_FILE
     if not path.exists():
         return
@@ -312,7 +320,8 @@ def check_same_run(config: TrainConfig, workdir: str | os.PathLike) -> None:
     if differ:
         raise ValueError(f"{workdir} was trained with {', '.join(f'{k}={recorded.get(k)!r}' for k in differ)}, "
                          f"this config has {', '.join(f'{k}={given[k]!r}' for k in differ)}: give the run's own "
-                         "--set flags to export it (its metadata, images_seen and data_streams, come from them)")
+                         "--set flags to resume or export it (a model's images_seen and data_streams come from "
+                         "them), or another --workdir")
 
 
 def export(config: TrainConfig, state: TrainState, path: str | os.PathLike,
