@@ -59,16 +59,23 @@ def test_a_model_worse_everywhere_gets_the_closed_form_weight():
     assert crosscheck.blend_weight(y, y + e, y + e) == 1.0  # equal estimates: the model is never worse
 
 
-def test_hold_out_removes_a_fixed_fifth_of_the_samples():
+def test_the_folds_hold_out_every_sample_once():
+    """203 samples in 5 folds of 41 or 40: each kept map is the input without its fold, the folds are disjoint and
+    cover every sample, and the same input gives the same folds."""
     sparse = _scattered(_plane(), 203)
-    kept, rows, cols = crosscheck.hold_out(sparse)
-    assert rows.size == round(0.2 * 203) == 41 and np.all(sparse[rows, cols] > 0) and np.all(kept[rows, cols] == 0)
-    restored = kept.copy()
-    restored[rows, cols] = sparse[rows, cols]
-    np.testing.assert_array_equal(restored, sparse)  # nothing else changed
-    again = crosscheck.hold_out(sparse)
-    np.testing.assert_array_equal(again[1], rows)
-    np.testing.assert_array_equal(again[2], cols)
+    folds = crosscheck.fold_out(sparse)
+    assert [rows.size for _, rows, _ in folds] == [41, 41, 41, 40, 40]
+    held = np.zeros(sparse.shape, int)
+    for kept, rows, cols in folds:
+        assert np.all(sparse[rows, cols] > 0) and np.all(kept[rows, cols] == 0)
+        restored = kept.copy()
+        restored[rows, cols] = sparse[rows, cols]
+        np.testing.assert_array_equal(restored, sparse)  # nothing else changed
+        held[rows, cols] += 1
+    np.testing.assert_array_equal(held, (sparse > 0).astype(int))  # every sample held out exactly once
+    for (_, rows, cols), (_, again_rows, again_cols) in zip(folds, crosscheck.fold_out(sparse)):
+        np.testing.assert_array_equal(again_rows, rows)
+        np.testing.assert_array_equal(again_cols, cols)
 
 
 def test_it_applies_to_100_scattered_samples_or_more_and_never_to_scan_lines():
@@ -87,9 +94,10 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     sparse = _scattered(depth, 300)
     off = depth + 1.0
     x, w = crosscheck.cross_checked(lambda s: off, sparse, off)
-    kept, rows, cols = crosscheck.hold_out(sparse)
-    y, x_l = sparse[rows, cols], linear_fill(kept)[rows, cols]
-    d = off[rows, cols] - x_l
+    folds = crosscheck.fold_out(sparse)
+    y = np.concatenate([sparse[rows, cols] for _, rows, cols in folds])
+    x_l = np.concatenate([linear_fill(kept)[rows, cols] for kept, rows, cols in folds])
+    d = np.concatenate([off[rows, cols] for _, rows, cols in folds]) - x_l
     assert w == pytest.approx(np.clip(np.sum((y - x_l) * d) / np.sum(d * d), 0, 1), rel=1e-6) and 0.0 <= w < 0.02
     np.testing.assert_allclose(x, w * off + (1 - w) * linear_fill(sparse), rtol=1e-6)
     inside = np.abs(linear_fill(sparse) - depth) < 1e-4
@@ -124,22 +132,23 @@ def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
 
 
 def test_the_held_out_estimate_runs_where_the_kept_samples_lie_as_far_apart_as_in_training():
-    """200 points on 480x640 run at 196x261; the 160 kept after the hold-out lie sqrt(200 / 160) x further apart, so
+    """200 points on 480x640 run at 196x261; the 160 kept beside a fold of 40 lie sqrt(200 / 160) x further apart, so
     their working size is that much smaller, and never larger than the frame's own run (a max_side cap)."""
     from lipjax.resolution import TARGET_SPACING_PX
 
     sparse = _scattered(np.full((480, 640), 3.0, np.float32), 200)
-    kept, _, _ = crosscheck.hold_out(sparse)
+    kept = crosscheck.fold_out(sparse)[0][0]
     s = TARGET_SPACING_PX / math.sqrt(480 * 640 / 160)
     assert crosscheck.held_out_size((196, 261), kept) == (round(480 * s), round(640 * s)) == (175, 234)
     assert crosscheck.held_out_size((120, 160), kept) == (120, 160)
     dense = _scattered(np.full((48, 64), 3.0, np.float32), 2000)  # 1.2 px apart: full size, as the frame
-    assert crosscheck.held_out_size((48, 64), crosscheck.hold_out(dense)[0]) == (48, 64)
+    assert crosscheck.held_out_size((48, 64), crosscheck.fold_out(dense)[0][0]) == (48, 64)
 
 
 def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
-    """100 points on 160x200 run at full size; the 80 kept lie 20 px apart, so the held-out run is at 0.8x (128x160):
-    the model sees the resized image there, and every sample is still kept in the output."""
+    """100 points on 160x200 run at full size; the 80 kept beside each fold of 20 lie 20 px apart, so the held-out
+    runs are at 0.8x (128x160): the model sees the resized image there, and every sample is still kept in the
+    output."""
     depth = _plane(160, 200)
     sparse = _scattered(depth, 100)
     sizes = []
@@ -147,7 +156,7 @@ def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
     monkeypatch.setattr(Completer, "__call__", lambda self, rgb, s: sizes.append(rgb.shape[:2]) or call(self, rgb, s))
     model = Completer.random(LIPConfig(initial_estimate="nearest"))
     x = complete_at(model, np.full(depth.shape + (3,), 128, np.uint8), sparse, depth.shape)
-    assert sizes == [(160, 200), (128, 160)]
+    assert sizes == [(160, 200)] + [(128, 160)] * crosscheck.FOLDS
     np.testing.assert_array_equal(x[sparse > 0], sparse[sparse > 0])
 
 
