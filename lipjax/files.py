@@ -105,7 +105,7 @@ values exactly.
 also runs the mirror image of each frame and averages the two: more accurate, twice the model's time.
 With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
 every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
-`--no-cross-check` runs the model alone, once instead of six times.
+`--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
 print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.

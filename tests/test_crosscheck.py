@@ -109,6 +109,20 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     assert w == 1.0 and x is off
 
 
+def test_a_model_that_fits_the_first_fold_costs_one_held_out_run():
+    """The first fold runs alone: a model closer than the linear fill at more than half of its held-out depths keeps
+    w = 1 without the other folds (one call of `estimate`); one that misses most of them by more gets all FOLDS runs,
+    and the weight is then fitted on every sample."""
+    depth = _plane()
+    sparse = _scattered(depth, 300)
+    bowl = depth + 0.05 * ((np.arange(depth.shape[1]) - 32) / 32.0) ** 2  # the plane bent: linear is exact, this not
+    calls = []
+    for estimate_of, runs in ((lambda s: depth, 1), (lambda s: bowl, crosscheck.FOLDS)):
+        calls.clear()
+        crosscheck.cross_checked(lambda s: calls.append(1) or estimate_of(s), sparse, estimate_of(sparse))
+        assert len(calls) == runs
+
+
 def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
     """An untrained model (identity prox) returns its nearest fill, worse than the linear fill on a plane: the
     default path leans on the linear fill and comes closer to the depth, keeps every sample, and
