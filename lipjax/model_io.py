@@ -122,7 +122,7 @@ def metadata(name_or_path: str | os.PathLike) -> dict:
     return _read_doc(resolve(name_or_path)).get("metadata", {})
 
 
-TABLE_COLUMNS = ("MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL RMSE", "VALIDATED ON", "TRAINED ON")
+TABLE_COLUMNS = ("MODEL", "DEFAULT", "TYPE", "ITERS", "Z0", "RANGE", "VAL RMSE", "VALIDATED ON", "IMAGES SEEN")
 
 
 def default_mark(defaults: dict[str, str], name: str) -> str:
@@ -137,7 +137,7 @@ def table(defaults: dict[str, str]) -> str:
     config and metadata: DEFAULT names the scene(s) whose default it is (`default_mark`; `defaults`: scene ->
     name, e.g. lipjax.shipped.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
     type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
-    (its sampler); "-" where unknown or not applicable."""
+    (its sampler); IMAGES SEEN the training budget (metadata images_seen); "-" where unknown or not applicable."""
     rows = [TABLE_COLUMNS]
     for name in available():
         config = config_from_dict(_read_doc(resolve(name))["config"])
@@ -151,7 +151,7 @@ def table(defaults: dict[str, str]) -> str:
         rows.append((name, default_mark(defaults, name), kind, iters, z0,
                      f"{config.max_depth_m:g} m", "-" if rmse is None else f"{rmse:.4f} m",
                      meta.get("val_sampler", "-"),
-                     f"{meta['images_seen']:,} images" if "images_seen" in meta else "-"))
+                     f"{meta['images_seen']:,}" if "images_seen" in meta else "-"))
     widths = [max(len(r[i]) for r in rows) for i in range(len(TABLE_COLUMNS))]
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
 
