@@ -34,13 +34,14 @@ as many with `mirror`) and the linear fill at the held-out samples, plus a full 
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
 from lipjax.inputs import is_lidar_pattern, quiet_checks
-from lipjax.resolution import dense_from, sample_spacing_px, working_size
+from lipjax.resolution import dense_from, working_size
 
 FOLDS = 5  # the samples are held out in this many disjoint folds, each completed from the others
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
@@ -67,11 +68,15 @@ def fold_out(sparse_m: np.ndarray, folds: int = FOLDS, seed: int = SEED) -> list
     return out
 
 
-def held_out_size(size: tuple[int, int], kept_m: np.ndarray) -> tuple[int, int]:
-    """(h, w) at which the held-out estimate runs: the working size of the kept samples' own spacing
-    (lipjax.resolution.working_size), where the model sees them as far apart as it was trained to, never more
-    pixels than `size`, the frame's own run (which a caller's max_side may have capped)."""
-    own = working_size(np.shape(kept_m), sample_spacing_px(kept_m))
+def held_out_size(size: tuple[int, int], sparse_m: np.ndarray) -> tuple[int, int]:
+    """(h, w) at which every fold's held-out estimate of the (H, W) sparse map runs: the working size
+    (lipjax.resolution.working_size) of the spacing sqrt(H W / m) of the m = n - ceil(n / FOLDS) samples the first
+    fold keeps (`fold_out`'s largest fold comes first), where the model sees them as far apart as it was trained to;
+    one size for all folds (one compiled program), never more pixels than `size`, the frame's own run (which a
+    caller's max_side may have capped)."""
+    n = int(np.count_nonzero(np.asarray(sparse_m) > 0))
+    shape = np.shape(sparse_m)
+    own = working_size(shape, math.sqrt(shape[0] * shape[1] / (n - math.ceil(n / FOLDS))))
     return own if own[0] * own[1] < size[0] * size[1] else tuple(size)
 
 
@@ -97,7 +102,9 @@ def cross_checked(estimate: Callable[[np.ndarray], np.ndarray], sparse_m: np.nda
     for j, (kept, rows, cols) in enumerate(fold_out(sparse_m)):
         with quiet_checks():  # the input checks already spoke about the user's frame, not this one
             z_kept = estimate(kept)
-        y.append(sparse_m[rows, cols]), x_m.append(z_kept[rows, cols]), x_l.append(linear_fill_at(kept, rows, cols))
+        y.append(sparse_m[rows, cols])
+        x_m.append(z_kept[rows, cols])
+        x_l.append(linear_fill_at(kept, rows, cols))
         if j == 0 and 2 * np.count_nonzero(np.abs(x_m[0] - y[0]) > np.abs(x_l[0] - y[0])) <= rows.size:
             return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds are not run (rule 53)
     w = blend_weight(np.concatenate(y), np.concatenate(x_m), np.concatenate(x_l))

@@ -128,11 +128,12 @@ def default_model(scene: str = "indoor") -> Completer:
 MIRROR_AVERAGE = False
 
 # Whether the default path checks a learned model against the linear fill on held-out samples and leans on the
-# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by a rule
-# on synthetic frames (docs/design-notes.md, "A check against the linear fill"). Off (`cross_check=False`, `lipjax
-# complete --no-cross-check`): the model's estimate alone, run once instead of twice on scattered samples (480x640
-# with 200 points, training paused: 98 ms checked (the held-out run at the kept samples' own working size, rule 48)
-# against about 56 ms); what the ONNX graph computes.
+# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by rules
+# on synthetic frames (docs/design-notes.md, "A check against the linear fill", rules 52-53). Off (`cross_check=False`,
+# `lipjax complete --no-cross-check`): the model's estimate alone, run once instead of twice (six times where the
+# first held-out fold goes against the model) on scattered samples (480x640 with 200 points, training paused: 55 ms
+# checked, the held-out run at the kept samples' own working size, rule 48, against 28 ms); what the ONNX graph
+# computes.
 CROSS_CHECK = True
 
 # Whether the default path (`complete_at`, the ONNX graph) spreads the samples' residuals over the frame after
@@ -258,7 +259,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
 
     dense = estimate(sparse_m, (h, w))
     if cross_check and isinstance(completer, Completer):
-        dense, _ = crosscheck.cross_checked(lambda kept: estimate(kept, crosscheck.held_out_size((h, w), kept)),
+        dense, _ = crosscheck.cross_checked(lambda kept: estimate(kept, crosscheck.held_out_size((h, w), sparse_m)),
                                             sparse_m, dense)
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]

@@ -212,7 +212,7 @@ _QUIET = contextvars.ContextVar("lipjax_quiet_input_checks", default=False)
 @contextlib.contextmanager
 def quiet_checks() -> Iterator[None]:
     """Within: the input checks raise as ever but do not warn (a second look at a frame whose checks already spoke,
-    lipjax.crosscheck's held-out run). Unlike warnings.catch_warnings it leaves the filters alone, whose every
+    lipjax.crosscheck's held-out runs). Unlike warnings.catch_warnings it leaves the filters alone, whose every
     change makes Python forget which warnings it has shown (a folder of frames would warn on every frame)."""
     token = _QUIET.set(True)
     try:

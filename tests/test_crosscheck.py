@@ -151,12 +151,14 @@ def test_the_held_out_estimate_runs_where_the_kept_samples_lie_as_far_apart_as_i
     from lipjax.resolution import TARGET_SPACING_PX
 
     sparse = _scattered(np.full((480, 640), 3.0, np.float32), 200)
-    kept = crosscheck.fold_out(sparse)[0][0]
     s = TARGET_SPACING_PX / math.sqrt(480 * 640 / 160)
-    assert crosscheck.held_out_size((196, 261), kept) == (round(480 * s), round(640 * s)) == (175, 234)
-    assert crosscheck.held_out_size((120, 160), kept) == (120, 160)
+    assert crosscheck.held_out_size((196, 261), sparse) == (round(480 * s), round(640 * s)) == (175, 234)
+    assert crosscheck.held_out_size((120, 160), sparse) == (120, 160)
     dense = _scattered(np.full((48, 64), 3.0, np.float32), 2000)  # 1.2 px apart: full size, as the frame
-    assert crosscheck.held_out_size((48, 64), crosscheck.fold_out(dense)[0][0]) == (48, 64)
+    assert crosscheck.held_out_size((48, 64), dense) == (48, 64)
+    uneven = _scattered(np.full((480, 640), 3.0, np.float32), 203)  # folds of 41 and 40: all at the first's size
+    t = TARGET_SPACING_PX / math.sqrt(480 * 640 / (203 - 41))
+    assert crosscheck.held_out_size((196, 261), uneven) == (round(480 * t), round(640 * t))
 
 
 def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):

@@ -215,6 +215,8 @@ def train(
     validate_start: bool = False,
 ) -> TrainState:
     """Trains (or resumes) a run in `workdir` until config.total_steps (or `stop_at`, to split a run in parts).
+    A resume with another init_from, seed, batch size or data setting than the run's record is a ValueError
+    (`check_same_run`) before any step.
     validate_start: also validate (and log) the starting parameters at step 0 of a new run, the score that
     fine-tuning is to improve on.
 
@@ -234,7 +236,7 @@ def train(
     if manager.latest_step() is not None:  # a resume: the steps so far read the recorded config's data
         try:
             check_same_run(config, workdir)
-        except ValueError:
+        except BaseException:
             manager.close()
             raise
     (workdir / "config.txt").write_text(repr(config) + "\n")

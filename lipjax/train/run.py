@@ -117,8 +117,9 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     readable (lipjax.train.folder.check_frames).
 
     export_only: skip training and export the latest checkpoint (`config` must be the run's own:
-    lipjax.train.loop.check_same_run). average: validate and export the mean parameters of the newest `average`
-    checkpoints instead (`averaged_params`; their steps go into the model's metadata as `checkpoints`).
+    lipjax.train.loop.check_same_run, which `train` also checks when it resumes). average: validate and export the
+    mean parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
+    metadata as `checkpoints`).
     validate_start: validate the starting parameters too (lipjax.train.loop.train); the last line then gives both
     scores. Returns the validation metrics (metres).
     """
