@@ -120,11 +120,11 @@ def test_a_resume_needs_the_runs_own_config(straight_run, tmp_path):
 
     workdir = tmp_path / "copy"
     shutil.copytree(straight_run[0], workdir)
-    record = (workdir / loop.RUN_FILE).read_text()
+    record, config_text = (workdir / loop.RUN_FILE).read_text(), (workdir / "config.txt").read_text()
     with pytest.raises(ValueError, match="trained with seed=0, this config has seed=7") as error:
         loop.train(dataclasses.replace(CONFIG, seed=7, adv_steps=CONFIG.adv_steps + 2), workdir, progress=False)
     assert "\n" not in str(error.value)
-    assert (workdir / loop.RUN_FILE).read_text() == record
+    assert (workdir / loop.RUN_FILE).read_text() == record and (workdir / "config.txt").read_text() == config_text
     manager = CheckpointManager(workdir / "checkpoints", keep=CONFIG.keep_checkpoints)
     assert manager.latest_step() == CONFIG.total_steps
     manager.close()
