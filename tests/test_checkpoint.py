@@ -62,6 +62,9 @@ def test_no_restorable_checkpoint_names_the_folder_to_move_away(tmp_path):
     assert sorted(p.name for p in directory.iterdir() if p.name.isdigit()) == ["1", "2"]  # nothing moved
 
 
+# the damaged checkpoint's failed restore leaves orbax reads in flight, whose completions raise "Event loop is closed"
+# in orbax's threads after the test (lipjax.train.checkpoint._orbax_noise_silenced); pytest reports them as unraisable
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 def test_training_resumes_from_the_previous_checkpoint_and_finishes(tmp_path, capfd):
     # capfd, not capsys: orbax's threads write to file descriptor 2 directly
     workdir = tmp_path / "run"
