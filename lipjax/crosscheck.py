@@ -35,7 +35,7 @@ as many with `mirror`) and the linear fill at the held-out samples, plus a full 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -56,16 +56,15 @@ def applies(sparse_m: np.ndarray) -> bool:
     return MIN_SAMPLES <= n < dense_from(sparse_m.size) and not is_lidar_pattern(sparse_m)
 
 
-def fold_out(sparse_m: np.ndarray, folds: int = FOLDS, seed: int = SEED) -> list:
-    """[(kept (H, W) metres, rows, cols)], one per fold: a seeded permutation of the n samples cut in `folds` parts
-    of n // folds or one more; kept is the sparse map with that fold's samples (at rows, cols) set to 0."""
+def fold_out(sparse_m: np.ndarray, folds: int = FOLDS, seed: int = SEED) -> Iterator[tuple]:
+    """(kept (H, W) metres, rows, cols), one per fold, made as they are asked for (the check often stops after the
+    first): a seeded permutation of the n samples cut in `folds` parts of n // folds or one more, largest first;
+    kept is the sparse map with that fold's samples (at rows, cols) set to 0."""
     rows, cols = np.nonzero(sparse_m > 0)
-    out = []
     for held in np.array_split(np.random.default_rng(seed).permutation(rows.size), folds):
         kept = np.array(sparse_m, np.float32)
         kept[rows[held], cols[held]] = 0.0
-        out.append((kept, rows[held], cols[held]))
-    return out
+        yield kept, rows[held], cols[held]
 
 
 def held_out_size(size: tuple[int, int], sparse_m: np.ndarray) -> tuple[int, int]:
@@ -80,11 +79,16 @@ def held_out_size(size: tuple[int, int], sparse_m: np.ndarray) -> tuple[int, int
     return own if own[0] * own[1] < size[0] * size[1] else tuple(size)
 
 
+def misses_more(y: np.ndarray, x_m: np.ndarray, x_l: np.ndarray) -> int:
+    """k of the module doc: how many of the depths y the model's values x_m miss by more than the linear fill's x_l."""
+    return int(np.count_nonzero(np.abs(x_m - y) > np.abs(x_l - y)))
+
+
 def blend_weight(y: np.ndarray, x_m: np.ndarray, x_l: np.ndarray, p_value: float = P_VALUE) -> float:
     """w of the module doc from the held-out depths y and the model's and the linear fill's values x_m, x_l there."""
     from scipy.stats import binomtest
 
-    k = int(np.count_nonzero(np.abs(x_m - y) > np.abs(x_l - y)))  # k > 0 implies x_m != x_l somewhere
+    k = misses_more(y, x_m, x_l)  # k > 0 implies x_m != x_l somewhere
     if binomtest(k, y.size, 0.5, alternative="greater").pvalue >= p_value:
         return 1.0
     d = x_m - x_l
@@ -105,7 +109,7 @@ def cross_checked(estimate: Callable[[np.ndarray], np.ndarray], sparse_m: np.nda
         y.append(sparse_m[rows, cols])
         x_m.append(z_kept[rows, cols])
         x_l.append(linear_fill_at(kept, rows, cols))
-        if j == 0 and 2 * np.count_nonzero(np.abs(x_m[0] - y[0]) > np.abs(x_l[0] - y[0])) <= rows.size:
+        if j == 0 and 2 * misses_more(y[0], x_m[0], x_l[0]) <= rows.size:
             return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds are not run (rule 53)
     w = blend_weight(np.concatenate(y), np.concatenate(x_m), np.concatenate(x_l))
     if w == 1.0:

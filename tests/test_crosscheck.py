@@ -63,7 +63,7 @@ def test_the_folds_hold_out_every_sample_once():
     """203 samples in 5 folds of 41 or 40: each kept map is the input without its fold, the folds are disjoint and
     cover every sample, and the same input gives the same folds."""
     sparse = _scattered(_plane(), 203)
-    folds = crosscheck.fold_out(sparse)
+    folds = list(crosscheck.fold_out(sparse))
     assert [rows.size for _, rows, _ in folds] == [41, 41, 41, 40, 40]
     held = np.zeros(sparse.shape, int)
     for kept, rows, cols in folds:
@@ -94,7 +94,7 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     sparse = _scattered(depth, 300)
     off = depth + 1.0
     x, w = crosscheck.cross_checked(lambda s: off, sparse, off)
-    folds = crosscheck.fold_out(sparse)
+    folds = list(crosscheck.fold_out(sparse))
     y = np.concatenate([sparse[rows, cols] for _, rows, cols in folds])
     x_l = np.concatenate([linear_fill(kept)[rows, cols] for kept, rows, cols in folds])
     d = np.concatenate([off[rows, cols] for _, rows, cols in folds]) - x_l
