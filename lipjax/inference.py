@@ -257,10 +257,10 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
         return spread_on_host(z, sparse, at, scan_lines) if spread else z  # before any set-back
 
-    dense = estimate(sparse_m, (h, w))
     if cross_check and isinstance(completer, Completer):
-        dense, _ = crosscheck.cross_checked(lambda kept: estimate(kept, crosscheck.held_out_size((h, w), sparse_m)),
-                                            sparse_m, dense)
+        dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w))
+    else:
+        dense = estimate(sparse_m, (h, w))
     measured = sparse_m > 0
     dense[measured] = sparse_m[measured]
     return dense

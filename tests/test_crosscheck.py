@@ -1,11 +1,12 @@
 """The per-frame check of a learned model against the linear fill on held-out samples (lipjax.crosscheck)."""
 import math
+import threading
 import warnings
 
 import numpy as np
 import pytest
 
-from lipjax import crosscheck
+from lipjax import crosscheck, inputs
 from lipjax.classical.interpolate import linear_fill
 from lipjax.inference import Completer, complete_at
 from lipjax.model import LIPConfig
@@ -93,7 +94,7 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     depth = _plane()
     sparse = _scattered(depth, 300)
     off = depth + 1.0
-    x, w = crosscheck.cross_checked(lambda s: off, sparse, off)
+    x, w = crosscheck.cross_checked(lambda s, at: off, sparse, depth.shape)
     folds = list(crosscheck.fold_out(sparse))
     y = np.concatenate([sparse[rows, cols] for _, rows, cols in folds])
     x_l = np.concatenate([linear_fill(kept)[rows, cols] for kept, rows, cols in folds])
@@ -102,25 +103,46 @@ def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept()
     np.testing.assert_allclose(x, w * off + (1 - w) * linear_fill(sparse), rtol=1e-6)
     inside = np.abs(linear_fill(sparse) - depth) < 1e-4
     assert inside.mean() > 0.8 and np.abs(x - depth)[inside].max() < 0.021  # w * 1 m at most
-    x, w = crosscheck.cross_checked(lambda s: depth, sparse, depth)
+    x, w = crosscheck.cross_checked(lambda s, at: depth, sparse, depth.shape)
     assert w == 1.0 and x is depth
     few = _scattered(depth, crosscheck.MIN_SAMPLES - 1)  # not checked: returned as it is
-    x, w = crosscheck.cross_checked(lambda s: off, few, off)
+    x, w = crosscheck.cross_checked(lambda s, at: off, few, depth.shape)
     assert w == 1.0 and x is off
 
 
 def test_a_model_that_fits_the_first_fold_costs_one_held_out_run():
-    """The first fold runs alone: a model closer than the linear fill at more than half of its held-out depths keeps
-    w = 1 without the other folds (one call of `estimate`); one that misses most of them by more gets all FOLDS runs,
-    and the weight is then fitted on every sample."""
+    """The first fold runs before the others: a model closer than the linear fill at more than half of its held-out
+    depths keeps w = 1 without the other folds (one held-out call of `estimate`, besides the frame's own); one that
+    misses most of them by more gets all FOLDS runs, and the weight is then fitted on every sample."""
     depth = _plane()
     sparse = _scattered(depth, 300)
     bowl = depth + 0.05 * ((np.arange(depth.shape[1]) - 32) / 32.0) ** 2  # the plane bent: linear is exact, this not
     calls = []
     for estimate_of, runs in ((lambda s: depth, 1), (lambda s: bowl, crosscheck.FOLDS)):
         calls.clear()
-        crosscheck.cross_checked(lambda s: calls.append(1) or estimate_of(s), sparse, estimate_of(sparse))
-        assert len(calls) == runs
+        crosscheck.cross_checked(lambda s, at: calls.append(1) or estimate_of(s), sparse, depth.shape)
+        assert len(calls) == 1 + runs  # the frame's own estimate and the held-out ones
+
+
+def test_the_first_fold_runs_beside_the_frames_own_estimate():
+    """XLA runs a model on about one core of two, so the first held-out estimate runs in another thread while the
+    frame's own runs: here the frame's estimate waits for it to start (run one after the other, it would wait in
+    vain), and every fold's call sees the quiet input checks, the frame's call not."""
+    depth = _plane()
+    sparse = _scattered(depth, 300)
+    started, waited, quiet = threading.Event(), [], []
+    bowl = depth + 0.05 * ((np.arange(depth.shape[1]) - 32) / 32.0) ** 2  # every fold runs
+
+    def estimate(s, at):
+        quiet.append(inputs._QUIET.get())
+        if np.count_nonzero(s) == 300:
+            waited.append(started.wait(timeout=60))
+        else:
+            started.set()
+        return bowl
+
+    crosscheck.cross_checked(estimate, sparse, depth.shape)
+    assert waited == [True] and sorted(quiet) == [False] + [True] * crosscheck.FOLDS
 
 
 def test_the_default_path_checks_a_learned_model_on_scattered_samples_only():
@@ -172,7 +194,7 @@ def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
     monkeypatch.setattr(Completer, "__call__", lambda self, rgb, s: sizes.append(rgb.shape[:2]) or call(self, rgb, s))
     model = Completer.random(LIPConfig(initial_estimate="nearest"))
     x = complete_at(model, np.full(depth.shape + (3,), 128, np.uint8), sparse, depth.shape)
-    assert sizes == [(160, 200)] + [(128, 160)] * crosscheck.FOLDS
+    assert sorted(sizes, reverse=True) == [(160, 200)] + [(128, 160)] * crosscheck.FOLDS  # in threads: any order
     np.testing.assert_array_equal(x[sparse > 0], sparse[sparse > 0])
 
 
