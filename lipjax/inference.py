@@ -131,9 +131,9 @@ MIRROR_AVERAGE = False
 # fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by rules
 # on synthetic frames (docs/design-notes.md, "A check against the linear fill", rules 52-53). Off (`cross_check=False`,
 # `lipjax complete --no-cross-check`): the model's estimate alone, run once instead of twice (six times where the
-# first held-out fold goes against the model) on scattered samples (480x640 with 200 points, training paused: 55 ms
-# checked, the held-out run at the kept samples' own working size, rule 48, against 28 ms); what the ONNX graph
-# computes.
+# first held-out fold goes against the model) on scattered samples (480x640 with 200 points, training paused: 36 ms
+# checked, the held-out run in a second thread at the kept samples' own working size, rule 48, against 26 ms); what
+# the ONNX graph computes.
 CROSS_CHECK = True
 
 # Whether the default path (`complete_at`, the ONNX graph) spreads the samples' residuals over the frame after
