@@ -44,14 +44,14 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
-from lipjax.inputs import is_lidar_pattern, quiet_checks
+from lipjax.inputs import is_lidar_pattern, quietly
 from lipjax.resolution import dense_from, working_size
 
 FOLDS = 5  # the samples are held out in this many disjoint folds, each completed from the others
 MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
 P_VALUE = 0.05  # the sign test's level: the model gives way only on this much evidence
 SEED = 0  # which samples fall in which fold: fixed, so that a frame always gives the same depth
-# Threads that run held-out estimates beside the frame's own (module doc): the first fold, then the other folds at once.
+# Threads that run held-out estimates beside the frame's own (module doc): the first fold, then the others at once.
 _FOLDS_BESIDE = ThreadPoolExecutor(max_workers=FOLDS - 1, thread_name_prefix="lipjax-crosscheck")
 
 
@@ -101,11 +101,6 @@ def blend_weight(y: np.ndarray, x_m: np.ndarray, x_l: np.ndarray, p_value: float
     return float(np.clip(np.sum((y - x_l) * d) / np.sum(d * d), 0.0, 1.0))
 
 
-def _quietly(estimate: Callable, kept: np.ndarray, at: tuple[int, int]) -> np.ndarray:
-    with quiet_checks():  # the input checks already spoke about the user's frame, not this one (and in this thread)
-        return estimate(kept, at)
-
-
 def cross_checked(estimate: Callable[[np.ndarray, tuple[int, int]], np.ndarray], sparse_m: np.ndarray,
                   size: tuple[int, int]) -> tuple[np.ndarray, float]:
     """(x, w): z = estimate(sparse_m, size), the model's (H, W) estimate from every sample of `sparse_m` (metres)
@@ -118,13 +113,13 @@ def cross_checked(estimate: Callable[[np.ndarray, tuple[int, int]], np.ndarray],
     at = held_out_size(size, sparse_m)
     folds = fold_out(sparse_m)
     kept, rows, cols = next(folds)
-    first = _FOLDS_BESIDE.submit(_quietly, estimate, kept, at)
+    first = _FOLDS_BESIDE.submit(quietly, estimate, kept, at)
     z = estimate(sparse_m, size)
     y, x_m, x_l = [sparse_m[rows, cols]], [first.result()[rows, cols]], [linear_fill_at(kept, rows, cols)]
     if 2 * misses_more(y[0], x_m[0], x_l[0]) <= rows.size:
         return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds are not run (rule 53)
     rest = list(folds)
-    beside = [_FOLDS_BESIDE.submit(_quietly, estimate, kept, at) for kept, _, _ in rest]
+    beside = [_FOLDS_BESIDE.submit(quietly, estimate, kept, at) for kept, _, _ in rest]
     for (kept, rows, cols), z_kept in zip(rest, (future.result() for future in beside)):
         y.append(sparse_m[rows, cols])
         x_m.append(z_kept[rows, cols])

@@ -14,13 +14,14 @@ from __future__ import annotations
 import dataclasses
 import functools
 import os
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import jax
 import numpy as np
 
 from lipjax import crosscheck, model_io
-from lipjax.inputs import InputError, check_inputs, is_lidar_pattern  # noqa: F401  (lipjax.InputError)
+from lipjax.inputs import InputError, check_inputs, is_lidar_pattern, quietly  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
 from lipjax.resolution import MIN_MAX_SIDE_PX, is_capped, max_side_size, sample_spacing_px, working_size
@@ -122,10 +123,14 @@ def default_model(scene: str = "indoor") -> Completer:
 # Whether the default path (`complete_at`, `lipjax.complete`, `lipjax complete`, the ONNX graph) averages a learned
 # model's estimate with that of the mirror-image frame (`mirror_averaged`). Off: with the 228,000-image lip-any it is
 # more accurate (`benchmarks/generalisation.py --frames 8`: 0.7755 -> 0.7661 x linear, every setting better but far
-# views, 0.958 -> 0.964) but takes twice the model's time (benchmarks/speed.py: 480x640 with 200 points 62 -> 117
-# ms, 17.7 -> 9.6 frames/s normalised; 352x1216 with 64 beams 75 -> 139 ms), below the 10 frames/s the default
-# path keeps. Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
+# views, 0.958 -> 0.964) but takes twice the model's work (benchmarks/speed.py, as one batch of two: 480x640 with
+# 200 points 62 -> 117 ms, 17.7 -> 9.6 frames/s normalised; 352x1216 with 64 beams 75 -> 139 ms), below the 10
+# frames/s the default path keeps (since run in two threads on the CPU: 352x1216 34 -> 40 ms, 480x640 with the check
+# 36 -> 61 ms). Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
 MIRROR_AVERAGE = False
+# Threads that run the mirror image's estimate beside the frame's (`mirror_averaged`, on the CPU): a pool of its own,
+# as a held-out fold running in lipjax.crosscheck's threads may ask for one; one per fold and one for the frame.
+_MIRROR_BESIDE = ThreadPoolExecutor(max_workers=crosscheck.FOLDS + 1, thread_name_prefix="lipjax-mirror")
 
 # Whether the default path checks a learned model against the linear fill on held-out samples and leans on the
 # fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by rules
@@ -212,9 +217,15 @@ class AtWorkingSize:
 
 def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray) -> np.ndarray:
     """(z(I, y) + flip(z(flip(I), flip(y)))) / 2 for one frame, rgb (h, w, 3) and sparse (h, w) metres: the model's
-    estimate averaged with its estimate of the mirror-image frame, flipped back (one batched call)."""
-    both = completer(np.stack([rgb, rgb[:, ::-1]]), np.stack([sparse_m, sparse_m[:, ::-1]]))
-    return 0.5 * (both[0] + both[1][:, ::-1])
+    estimate averaged with its estimate of the mirror-image frame, flipped back. On the CPU the two run side by side
+    in two threads, as XLA runs a model on about one core (lip-any on the 352x1216 street at 132x455, training
+    paused: 32 ms in two threads, 52 ms as one batch of two, 26 ms for one frame); elsewhere as one batch of two."""
+    if jax.default_backend() != "cpu":
+        both = completer(np.stack([rgb, rgb[:, ::-1]]), np.stack([sparse_m, sparse_m[:, ::-1]]))
+        return 0.5 * (both[0] + both[1][:, ::-1])
+    mirrored = _MIRROR_BESIDE.submit(quietly, completer, rgb[:, ::-1], sparse_m[:, ::-1])  # checked as the frame is
+    z = completer(rgb, sparse_m)
+    return 0.5 * (z + mirrored.result()[:, ::-1])
 
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,

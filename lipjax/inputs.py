@@ -27,7 +27,8 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from typing import TypeVar
 
 import numpy as np
 
@@ -36,6 +37,8 @@ from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.resolution import dense_from
 from lipjax.shipped import DEFAULT_MODELS, available
 from lipjax.utils import warn_user
+
+T = TypeVar("T")
 
 # A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
@@ -219,6 +222,13 @@ def quiet_checks() -> Iterator[None]:
         yield
     finally:
         _QUIET.reset(token)
+
+
+def quietly(fn: Callable[..., T], *args) -> T:
+    """fn(*args) within `quiet_checks`: a second look at a frame, run in a thread of its own (a new thread does not
+    inherit the caller's context, so it must say itself that its checks are quiet)."""
+    with quiet_checks():
+        return fn(*args)
 
 
 def _warn(message: str) -> None:
