@@ -8,18 +8,17 @@
 Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
 --help describes the formats), and its errors name those flags.
 
-A folder overlaps reading, the model and writing: worker threads read and decode the next frames (OpenCV and
-numpy's file reads release the GIL) while the model runs on the current one in the calling thread, and one background
-thread post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is
-loaded once and compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames
-(`python benchmarks/folder_speed.py --keep DIR`, lip-any at 132x455) on the 2-core machine with nothing else
-running, a folder ran at 0.86x the warm single-frame rate (median of 7 runs, 0.78-0.87; single frame 44-48 ms);
-with the same 2 cores shared with a training run (load average 6-9) at 0.72x (median of 15 runs). Per frame a
-folder adds 17.5 ms of CPU that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1;
-with the model at 37 ms of CPU, one core in all bounds the ratio at 37 / 54.6 = 0.68. Every output file is written
-under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an
-unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the frames after
-it.
+A folder overlaps reading, the model and writing: worker threads read and decode the next frames (OpenCV and numpy's
+file reads release the GIL); the model runs on the first frame in the calling thread (one compilation), then on
+MODEL_THREADS frames at once in threads of their own (XLA runs a model on about one core); one background thread
+post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is loaded once and
+compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames (`python
+benchmarks/folder_speed.py --keep DIR`, lip-any at 132x455) on the 2-core machine with training paused, a folder ran
+at 1.06-1.18x the warm single-frame rate (3 runs; single frame 32-35 ms); one frame at a time it ran at 0.86-0.90x in
+the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Per frame a folder adds 17.5 ms of CPU that one
+frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1. Every output file is written under a
+temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an unreadable file,
+a full disk) leaves the frames before it written whole and nothing of itself or the frames after it.
 """
 from __future__ import annotations
 
@@ -74,9 +73,10 @@ COMPLETE_HELP = """\
             With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
             (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
             Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
-            (rgb_00050.jpg <-> sync_depth_00050.png). The next frames are read while the model runs, outputs are
-            written in the background, and the summary line gives frames/s. A frame that fails stops the run with
-            the frames before it written whole and nothing of itself (files are renamed into place once written).
+            (rgb_00050.jpg <-> sync_depth_00050.png). The next frames are read while the model runs (on two
+            frames at once after the first), outputs are written in the background, and the summary line gives
+            frames/s. A frame that fails stops the run with the frames before it written whole and nothing of
+            itself or after it (files are renamed into place once written).
   --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
             metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
   --uncertainty  also write the expected absolute error of the completed depth, metres:
@@ -114,6 +114,9 @@ A frame above 2 Mpixel run without --max-side gets a one-line hint.
 """The inputs, outputs and options of `complete_files` in the words of `lipjax complete --help`, which shows it."""
 READ_WORKERS = 2
 """Threads that read and decode the next frames of a folder while the model runs."""
+MODEL_THREADS = 2
+"""Frames of a folder completed at once, each in a thread of its own: XLA runs a model on about one core (two frames
+keep this machine's two busy; lipjax.crosscheck), and a frame's host work (resizes, fills) overlaps the other's."""
 READ_AHEAD = 4
 """Frames read ahead of the model (they wait in memory: a KITTI frame with its depth takes about 3 MB)."""
 WRITE_BACKLOG = 4
@@ -321,23 +324,47 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
          max_side: int | None, mirror: bool, cross_check: bool, progress: bool,
          log: Callable[[str], None] | None, workers: int) -> None:
-    """Reads (prefetched), completes (this thread) and writes (`_Writer`) every job of the plan, in order. The
-    model is loaded after the first frame is read (input errors come before the slow model load); the progress
-    bar starts after the line naming it."""
+    """Reads (prefetched), completes and writes (`_Writer`) every job of the plan, in order: the first frame in
+    this thread, then MODEL_THREADS frames at a time in threads of their own. The model is loaded after the first
+    frame is read (input errors come before the slow model load); the progress bar starts after the line naming
+    it. A frame that fails (read or completed) is written never, nor are those after it; those before it are."""
     from tqdm import tqdm
 
     completer = bar = None
+    in_flight: collections.deque = collections.deque()  # (the frame's future, its job and inputs), in order
+
+    def finish() -> None:  # the oldest frame in flight, written (after every frame before it)
+        future, job, rgb, sparse, intrinsics = in_flight.popleft()
+        writer.submit(job, rgb, sparse, future.result(), intrinsics)
+        bar.update()
+
     try:
-        with contextlib.closing(prefetched(read, plan.jobs, workers)) as frames, _Writer(output) as writer:
-            for job, rgb, sparse, intrinsics in frames:
-                if completer is None:
+        with contextlib.closing(prefetched(read, plan.jobs, workers)) as frames, _Writer(output) as writer, \
+                ThreadPoolExecutor(MODEL_THREADS, thread_name_prefix="lipjax-model") as pool:
+            while True:
+                try:
+                    job, rgb, sparse, intrinsics = next(frames)
+                except StopIteration:
+                    break
+                except BaseException:  # a frame that cannot be read: the frames before it are written whole
+                    while in_flight:
+                        finish()
+                    raise
+                if completer is None:  # the first frame alone, in this thread: one compilation, warnings from here
                     completer = _load(model, iterations, sparse, job.rgb, max_side, log)
                     output.max_depth_m = model_max_depth(completer)
                     bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
                                disable=not progress or len(plan.jobs) < 2)
-                dense = complete_frame(completer, rgb, sparse, max_side, mirror=mirror, cross_check=cross_check)
-                writer.submit(job, rgb, sparse, dense, intrinsics)
-                bar.update()
+                    dense = complete_frame(completer, rgb, sparse, max_side, mirror=mirror, cross_check=cross_check)
+                    writer.submit(job, rgb, sparse, dense, intrinsics)
+                    bar.update()
+                    continue
+                in_flight.append((pool.submit(complete_frame, completer, rgb, sparse, max_side, mirror=mirror,
+                                              cross_check=cross_check), job, rgb, sparse, intrinsics))
+                if len(in_flight) == MODEL_THREADS:
+                    finish()
+            while in_flight:
+                finish()
     finally:
         if bar is not None:
             bar.close()
