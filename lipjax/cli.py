@@ -154,7 +154,7 @@ def _add_complete_parser(sub) -> None:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
-    c.add_argument("--mirror", action="store_true", help="learned models: average with the mirror image (2x time)")
+    c.add_argument("--mirror", action="store_true", help="learned models: average with the mirror image (2x work)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")

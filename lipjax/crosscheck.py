@@ -115,7 +115,8 @@ def cross_checked(estimate: Callable[[np.ndarray, tuple[int, int]], np.ndarray],
     kept, rows, cols = next(folds)
     first = _FOLDS_BESIDE.submit(quietly, estimate, kept, at)
     z = estimate(sparse_m, size)
-    y, x_m, x_l = [sparse_m[rows, cols]], [first.result()[rows, cols]], [linear_fill_at(kept, rows, cols)]
+    y, x_l = [sparse_m[rows, cols]], [linear_fill_at(kept, rows, cols)]  # while the fold may still run
+    x_m = [first.result()[rows, cols]]
     if 2 * misses_more(y[0], x_m[0], x_l[0]) <= rows.size:
         return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds are not run (rule 53)
     rest = list(folds)

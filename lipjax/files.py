@@ -48,6 +48,7 @@ from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
 from lipjax.pointcloud import IntrinsicsLike, ProjectionCounts, backproject_rgbd, write_ply
 from lipjax.uncertainty import drop_uncertain, expected_error, support_mask, write_uncertainty
+from lipjax.utils import holding_warnings_back, warn_user
 from lipjax.viz import fitting_range
 
 DEFAULT_PNG_OUT_SCALE = KNOWN_DEPTH_SCALES["kitti"]
@@ -102,7 +103,7 @@ pixel of the small grid it falls in, keeping its value (the nearest one wins whe
 averaged); the result is resized back (bilinear). At any size the measured pixels are then set to their measured
 values exactly.
 `--max-side N` overrides the working size: the longer side becomes at most N pixels. `--mirror` (learned models)
-also runs the mirror image of each frame and averages the two: more accurate, twice the model's time.
+also runs the mirror image of each frame and averages the two: more accurate, twice the model's work.
 With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
 every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
 `--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
@@ -115,8 +116,8 @@ A frame above 2 Mpixel run without --max-side gets a one-line hint.
 READ_WORKERS = 2
 """Threads that read and decode the next frames of a folder while the model runs."""
 MODEL_THREADS = 2
-"""Frames of a folder completed at once, each in a thread of its own: XLA runs a model on about one core (two frames
-keep this machine's two busy; lipjax.crosscheck), and a frame's host work (resizes, fills) overlaps the other's."""
+"""Frames of a folder a learned model completes at once, each in a thread of its own: XLA runs a model on about one
+core (two frames keep this machine's two busy; lipjax.crosscheck), and a frame's host work overlaps the other's."""
 READ_AHEAD = 4
 """Frames read ahead of the model (they wait in memory: a KITTI frame with its depth takes about 3 MB)."""
 WRITE_BACKLOG = 4
@@ -321,21 +322,36 @@ def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path
     return completer
 
 
+def model_threads(completer: Any) -> int:
+    """Frames of a folder completed at once: MODEL_THREADS for a learned model (a `Completer`), at most as many as
+    the cores this process may use (`--threads`); one for anything else (a classical fill holds the GIL most of the
+    time, and a model object of the user's is never called from two threads)."""
+    if not isinstance(completer, Completer):
+        return 1
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return max(1, min(MODEL_THREADS, cores))
+
+
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
          max_side: int | None, mirror: bool, cross_check: bool, progress: bool,
          log: Callable[[str], None] | None, workers: int) -> None:
     """Reads (prefetched), completes and writes (`_Writer`) every job of the plan, in order: the first frame in
-    this thread, then MODEL_THREADS frames at a time in threads of their own. The model is loaded after the first
-    frame is read (input errors come before the slow model load); the progress bar starts after the line naming
-    it. A frame that fails (read or completed) is written never, nor are those after it; those before it are."""
+    this thread, then `model_threads` frames at a time in threads of their own, whose warnings are shown from this
+    thread (once, at the user's line). The model is loaded after the first frame is read (input errors come before
+    the slow model load); the progress bar starts after the line naming it. A frame that fails (read or completed)
+    is written never, nor are those after it; those before it are."""
     from tqdm import tqdm
 
     completer = bar = None
+    threads = 1  # frames completed at once (`model_threads`), known once the model is
     in_flight: collections.deque = collections.deque()  # (the frame's future, its job and inputs), in order
 
-    def finish() -> None:  # the oldest frame in flight, written (after every frame before it)
+    def finish() -> None:  # the oldest frame in flight, its warnings shown and it written, after every frame before
         future, job, rgb, sparse, intrinsics = in_flight.popleft()
-        writer.submit(job, rgb, sparse, future.result(), intrinsics)
+        dense, held = future.result()
+        for message, category in held:
+            warn_user(message, category)
+        writer.submit(job, rgb, sparse, dense, intrinsics)
         bar.update()
 
     try:
@@ -346,22 +362,26 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
                     job, rgb, sparse, intrinsics = next(frames)
                 except StopIteration:
                     break
-                except BaseException:  # a frame that cannot be read: the frames before it are written whole
+                except Exception:  # a frame that cannot be read: the frames before it are written whole
                     while in_flight:
                         finish()
                     raise
-                if completer is None:  # the first frame alone, in this thread: one compilation, warnings from here
+                first = completer is None
+                if first:
                     completer = _load(model, iterations, sparse, job.rgb, max_side, log)
                     output.max_depth_m = model_max_depth(completer)
+                    threads = model_threads(completer)
                     bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
                                disable=not progress or len(plan.jobs) < 2)
+                if first or threads == 1:  # in this thread (the first frame alone: one compilation)
                     dense = complete_frame(completer, rgb, sparse, max_side, mirror=mirror, cross_check=cross_check)
                     writer.submit(job, rgb, sparse, dense, intrinsics)
                     bar.update()
                     continue
-                in_flight.append((pool.submit(complete_frame, completer, rgb, sparse, max_side, mirror=mirror,
-                                              cross_check=cross_check), job, rgb, sparse, intrinsics))
-                if len(in_flight) == MODEL_THREADS:
+                in_flight.append((pool.submit(holding_warnings_back, complete_frame, completer, rgb, sparse,
+                                              max_side, mirror=mirror, cross_check=cross_check),
+                                  job, rgb, sparse, intrinsics))
+                if len(in_flight) == threads:
                     finish()
             while in_flight:
                 finish()
@@ -390,7 +410,7 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
       model, iterations: anything lipjax.methods.get_completer takes; None: the default of the first frame.
       max_side: run frames downsized to this longer side, pixels (default: the working size of the samples).
       mirror: average a learned model's estimate with that of the mirror-image frame (lipjax.inference.mirror_averaged:
-        more accurate, twice the model's time).
+        more accurate, twice the model's work).
       cross_check: check a learned model against the linear fill on held-out samples (lipjax.crosscheck).
       ply, intrinsics: also write a coloured point cloud (metres), with the RGB camera's intrinsics (pixels: an
         Intrinsics, (fx, fy, cx, cy), K, or a file lipjax.data.folder.read_intrinsics reads; a sweep's calibration

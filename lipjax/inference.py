@@ -129,7 +129,8 @@ def default_model(scene: str = "indoor") -> Completer:
 # 36 -> 61 ms). Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
 MIRROR_AVERAGE = False
 # Threads that run the mirror image's estimate beside the frame's (`mirror_averaged`, on the CPU): a pool of its own,
-# as a held-out fold running in lipjax.crosscheck's threads may ask for one; one per fold and one for the frame.
+# as a held-out fold running in lipjax.crosscheck's threads asks for one (its tasks wait on nothing, so a full pool
+# only queues them); one per fold and one for the frame.
 _MIRROR_BESIDE = ThreadPoolExecutor(max_workers=crosscheck.FOLDS + 1, thread_name_prefix="lipjax-mirror")
 
 # Whether the default path checks a learned model against the linear fill on held-out samples and leans on the

@@ -92,9 +92,9 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_unce
 
     `model`: anything `get_completer` takes; by default the shipped default model, indoor or outdoor as the samples
     suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`);
-    `mirror` also runs it on the mirror-image frame and averages (more accurate, twice the time; MIRROR_AVERAGE);
-    `cross_check` checks it against the linear fill on held-out samples (lipjax.crosscheck; CROSS_CHECK).
-    With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
+    `mirror` also runs it on the mirror-image frame and averages (more accurate, twice the model's work;
+    MIRROR_AVERAGE); `cross_check` checks it against the linear fill on held-out samples (lipjax.crosscheck;
+    CROSS_CHECK). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
     (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
     """
     completer = get_completer(model, sparse=sparse)

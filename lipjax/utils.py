@@ -3,13 +3,17 @@ whole."""
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import pathlib
 import sys
 import warnings
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from typing import TypeVar
 
 import jax
+
+T = TypeVar("T")
 
 
 def enable_compilation_cache(path: str | os.PathLike | None = None) -> pathlib.Path:
@@ -25,14 +29,34 @@ def enable_compilation_cache(path: str | os.PathLike | None = None) -> pathlib.P
     return path
 
 
+_HELD_BACK: contextvars.ContextVar[list | None] = contextvars.ContextVar("lipjax_held_back_warnings", default=None)
+
+
 def warn_user(message: str, category: type[Warning] = UserWarning) -> None:
     """warnings.warn pointing at the first caller outside the lipjax package (the user's line, whatever chain of
-    library calls and closures led to the warning; Python 3.12's `skip_file_prefixes`, by hand for 3.11)."""
+    library calls and closures led to the warning; Python 3.12's `skip_file_prefixes`, by hand for 3.11). Within
+    `holding_warnings_back` the warning is kept for the caller instead."""
+    held = _HELD_BACK.get()
+    if held is not None:
+        held.append((message, category))
+        return
     package = os.path.dirname(os.path.abspath(__file__)) + os.sep
     frame, level = sys._getframe(1), 2
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
+
+
+def holding_warnings_back(fn: Callable[..., T], *args, **kwargs) -> tuple[T, list[tuple[str, type[Warning]]]]:
+    """(fn(*args, **kwargs), the (message, category) of every `warn_user` warning it gave, not shown): for work in
+    a thread of its own, whose warnings its caller shows from its own thread (at the user's line, where Python's
+    registry shows each once) by passing them to `warn_user` again."""
+    held: list[tuple[str, type[Warning]]] = []
+    token = _HELD_BACK.set(held)
+    try:
+        return fn(*args, **kwargs), held
+    finally:
+        _HELD_BACK.reset(token)
 
 
 def die_with_parent() -> None:

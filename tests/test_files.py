@@ -7,6 +7,7 @@ import re
 import subprocess
 import sys
 import threading
+import warnings
 
 import cv2
 import numpy as np
@@ -14,7 +15,7 @@ import pytest
 
 import lipjax
 from lipjax import cli, files, model_io
-from lipjax.inference import compiled_apply
+from lipjax.inference import Completer, compiled_apply
 from lipjax.methods import get_completer
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
@@ -148,28 +149,48 @@ def test_reading_and_writing_overlap_the_model(tmp_path, monkeypatch):
     assert model.seen == [1.0, 2.0, 3.0] and len(list((tmp_path / "out").iterdir())) == 3
 
 
-def test_after_the_first_frame_two_are_completed_at_once_and_a_failing_one_stops_the_rest(tmp_path):
-    """XLA runs a model on about one core, so after the first frame (alone: one compilation) MODEL_THREADS frames
-    are completed at once: here the second frame waits until the third has begun (one frame at a time, it would wait
-    in vain). The fifth frame fails: the four before it are written, it and the sixth are not."""
-    assert files.MODEL_THREADS == 2
+def test_after_the_first_frame_two_are_completed_at_once_and_a_failing_one_stops_the_rest(tmp_path, monkeypatch):
+    """XLA runs a model on about one core, so after the first frame (alone: one compilation) a learned model
+    completes MODEL_THREADS frames at once: here the second frame waits until the third has begun (one frame at a
+    time, it would wait in vain). The fifth frame fails: the four before it are written, it and the sixth are not."""
+    assert files.MODEL_THREADS == 2 and files.model_threads(Completer.random()) == min(2, len(os.sched_getaffinity(0)))
+    assert files.model_threads(get_completer("nearest")) == 1  # fills and a user's objects: one frame at a time
     data = _frames(tmp_path / "in", ["0", "1", "2", "3", "4", "5"])
-    third_begun = threading.Event()
+    third_begun, call = threading.Event(), Completer.__call__
 
-    class Overlapping(_Recording):
-        def __call__(self, rgb, sparse):
-            if sparse[0, 0] == 2:
-                assert third_begun.wait(10), "frame 1 ran alone"
-            if sparse[0, 0] == 3:
-                third_begun.set()
-            if sparse[0, 0] == 5:
-                raise RuntimeError("frame 4 fails")
-            return super().__call__(rgb, sparse)
+    def overlapping(self, rgb, sparse):
+        if sparse[0, 0] == 2:
+            assert third_begun.wait(10), "frame 1 ran alone"
+        if sparse[0, 0] == 3:
+            third_begun.set()
+        if sparse[0, 0] == 5:
+            raise RuntimeError("frame 4 fails")
+        return call(self, rgb, sparse)
 
+    monkeypatch.setattr(files, "model_threads", lambda completer: 2)  # on a 1-core machine too
+    monkeypatch.setattr(Completer, "__call__", overlapping)
     with pytest.raises(RuntimeError, match="frame 4 fails"):
-        files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, model=Overlapping(),
-                             progress=False)
+        files.complete_files(data / "rgb", data / "depth", tmp_path / "out", depth_scale=SCALE, cross_check=False,
+                             model=Completer.random(LIPConfig(initial_estimate="nearest")), progress=False)
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["0.png", "1.png", "2.png", "3.png"]
+
+
+def test_a_folder_whose_frames_all_warn_warns_once_at_the_callers_line(tmp_path, monkeypatch):
+    """Frames completed in threads hold their warnings back for the calling thread, which shows them at the user's
+    line: five frames beyond an untrained indoor model's 10 m range warn once, as one frame does."""
+    for sub in ("rgb", "depth"):
+        (tmp_path / sub).mkdir()
+    for i in range(5):
+        cv2.imwrite(str(tmp_path / "rgb" / f"{i}.png"), np.full((H, W, 3), 128, np.uint8))
+        np.save(tmp_path / "depth" / f"{i}.npy", np.where(np.arange(H * W).reshape(H, W) % 7 == 0, 12.0, 0.0))
+    monkeypatch.setattr(files, "model_threads", lambda completer: 2)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("default")
+        files.complete_files(tmp_path / "rgb", tmp_path / "depth", tmp_path / "out", fill_all=True, progress=False,
+                             model=Completer.random(LIPConfig(initial_estimate="nearest")))
+    ranged = [w for w in shown if "10 m range" in str(w.message)]
+    assert len(ranged) == 1 and ranged[0].filename == __file__, [(str(w.message), w.filename) for w in shown]
+    assert len(list((tmp_path / "out").iterdir())) == 5
 
 
 def test_prefetched_keeps_the_order_and_raises_an_error_in_its_turn():
