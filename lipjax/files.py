@@ -25,6 +25,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import dataclasses
+import functools
 import itertools
 import os
 import sys
@@ -344,15 +345,18 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
 
     completer = bar = None
     threads = 1  # frames completed at once (`model_threads`), known once the model is
+    complete = functools.partial(complete_frame, max_side=max_side, mirror=mirror, cross_check=cross_check)
     in_flight: collections.deque = collections.deque()  # (the frame's future, its job and inputs), in order
 
-    def finish() -> None:  # the oldest frame in flight, its warnings shown and it written, after every frame before
-        future, job, rgb, sparse, intrinsics = in_flight.popleft()
-        dense, held = future.result()
+    def deliver(job, rgb, sparse, intrinsics, dense, held=()) -> None:  # in order: warnings shown, written, counted
         for message, category in held:
             warn_user(message, category)
         writer.submit(job, rgb, sparse, dense, intrinsics)
         bar.update()
+
+    def finish() -> None:  # the oldest frame in flight, after every frame before it
+        future, *frame = in_flight.popleft()
+        deliver(*frame, *future.result())
 
     try:
         with contextlib.closing(prefetched(read, plan.jobs, workers)) as frames, _Writer(output) as writer, \
@@ -374,12 +378,9 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
                     bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
                                disable=not progress or len(plan.jobs) < 2)
                 if first or threads == 1:  # in this thread (the first frame alone: one compilation)
-                    dense = complete_frame(completer, rgb, sparse, max_side, mirror=mirror, cross_check=cross_check)
-                    writer.submit(job, rgb, sparse, dense, intrinsics)
-                    bar.update()
+                    deliver(job, rgb, sparse, intrinsics, complete(completer, rgb, sparse))
                     continue
-                in_flight.append((pool.submit(holding_warnings_back, complete_frame, completer, rgb, sparse,
-                                              max_side, mirror=mirror, cross_check=cross_check),
+                in_flight.append((pool.submit(holding_warnings_back, complete, completer, rgb, sparse),
                                   job, rgb, sparse, intrinsics))
                 if len(in_flight) == threads:
                     finish()

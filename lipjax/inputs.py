@@ -28,7 +28,6 @@ from __future__ import annotations
 import contextlib
 import contextvars
 from collections.abc import Callable, Iterator
-from typing import TypeVar
 
 import numpy as np
 
@@ -36,9 +35,7 @@ from lipjax.data.folder import KNOWN_DEPTH_SCALES
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.resolution import dense_from
 from lipjax.shipped import DEFAULT_MODELS, available
-from lipjax.utils import warn_user
-
-T = TypeVar("T")
+from lipjax.utils import T, warn_user
 
 # A sparse map whose median reaches this is not in metres (no depth sensor here measures a kilometre).
 MAX_PLAUSIBLE_DEPTH_M = 1000.0
