@@ -14,7 +14,8 @@ pixels. The reference is `linear` (Delaunay piecewise-linear, nearest outside th
 Columns: the default path (`lipjax complete` without flags: `get_completer(None, sparse)` picks the model and
 `complete_frame` its working size), the same with a uniform grey image (the RGB guidance's worth: grey / RGB),
 ip_basic and colorization. `--model` scores one model through the same path instead of the default choice;
-`--mirror` runs the path with mirror averaging (`lipjax complete --mirror`) for the model and its grey run.
+`--mirror` runs the path with mirror averaging on every input (`lipjax complete --mirror`; by default on scan lines
+only) for the model and its grey run, `--no-mirror` on none.
 `--sweep` also runs the model at several target sample spacings (lipjax.resolution, with its pixel cap) and at the
 native size ("full"), and plots the geometric-mean ratio against the working resolution.
 """
@@ -83,7 +84,8 @@ def main(argv=None) -> None:
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
     ap.add_argument("--json", default=None)
-    ap.add_argument("--mirror", action="store_true", help="the default path with mirror averaging (--mirror)")
+    ap.add_argument("--mirror", action=argparse.BooleanOptionalAction,
+                    help="the path with (--mirror) or without (--no-mirror) mirror averaging on every input")
     ap.add_argument("--sweep", action="store_true", help="also sweep the working resolution")
     ap.add_argument("--plot", default=None, help="with --sweep: write the ratio-vs-resolution picture here")
     ap.add_argument("--classical", default="ip_basic,colorization", help="comma-separated classical methods")

@@ -39,7 +39,7 @@ from lipjax.train.run import fine_tune_folder
 from lipjax.utils import enable_compilation_cache, limit_cpu_threads
 
 PROG = "lipjax"
-_RAW = argparse.RawDescriptionHelpFormatter
+_RAW, _BOOL = argparse.RawDescriptionHelpFormatter, argparse.BooleanOptionalAction
 _depth_scale = console.argument_type(parse_depth_scale)  # --depth-scale: 256, 1000, kitti, nyu, ...
 
 
@@ -154,7 +154,7 @@ def _add_complete_parser(sub) -> None:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
-    c.add_argument("--mirror", action="store_true", help="learned models: average with the mirror image (2x work)")
+    c.add_argument("--mirror", action=_BOOL, help="average with the mirror image (2x work; default: on scan lines)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")
@@ -224,7 +224,7 @@ def _add_export_parser(sub) -> None:
     x.add_argument("--batch", type=console.positive_int, default=1)
     x.add_argument("--samples", type=console.positive_int, help=".onnx: samples per frame (sets the working size)")
     x.add_argument("--scattered", action="store_true", help=".onnx: scattered points, not LiDAR scan lines")
-    x.add_argument("--mirror", action="store_true", help=".onnx: as lipjax complete --mirror, in the graph")
+    x.add_argument("--mirror", action=_BOOL, help=".onnx: as lipjax complete's, in the graph (default: scan lines)")
     x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
     x.add_argument("--quiet", action="store_true")

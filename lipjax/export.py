@@ -173,11 +173,11 @@ class ExportedFile:
 
 def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
            platforms: Sequence[str] | None = None, samples: int | None = None, scattered: bool = False,
-           mirror: bool = False) -> ExportedFile | OnnxFile:
+           mirror: bool | None = None) -> ExportedFile | OnnxFile:
     """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
     (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`). `platforms`
     applies to .stablehlo, `samples` (per frame) and `scattered` (points, not LiDAR scan lines), which set the
-    working size, and `mirror` (lipjax.complete's mirror averaging in the graph), to .onnx.
+    working size, and `mirror` (lipjax.complete's mirror averaging in the graph; None: on scan lines), to .onnx.
 
     Raises ValueError for an unknown extension, an option of the other format or a hand-crafted fill (nothing
     learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the

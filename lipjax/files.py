@@ -43,7 +43,7 @@ from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, outp
                                 read_intrinsics, read_rgb, write_depth)
 from lipjax.data.lidar import project_sweep, read_lidar_frame
 from lipjax.data.sample import Intrinsics
-from lipjax.inference import CROSS_CHECK, MIRROR_AVERAGE, Completer, complete_frame, frame_size
+from lipjax.inference import CROSS_CHECK, Completer, complete_frame, frame_size
 from lipjax.inputs import scene_reason
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
@@ -103,8 +103,9 @@ new size costs one compilation. Below full size the RGB is area-resized; each me
 pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
 averaged); the result is resized back (bilinear). At any size the measured pixels are then set to their measured
 values exactly.
-`--max-side N` overrides the working size: the longer side becomes at most N pixels. `--mirror` (learned models)
-also runs the mirror image of each frame and averages the two: more accurate, twice the model's work.
+`--max-side N` overrides the working size: the longer side becomes at most N pixels. A learned model also runs the
+mirror image of LiDAR scan lines and averages the two (more accurate, twice the model's work, on the core the check
+leaves free); `--mirror` does so on every input, `--no-mirror` on none.
 With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
 every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
 `--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
@@ -394,7 +395,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
 def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike, *,
                    lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
                    depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
-                   max_side: int | None = None, mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK,
+                   max_side: int | None = None, mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
                    out_format: str | None = None,
                    color_range: tuple[float, float] | None = None, ply: str | os.PathLike | None = None,
                    intrinsics: IntrinsicsLike | str | os.PathLike | None = None,
@@ -411,7 +412,7 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
       model, iterations: anything lipjax.methods.get_completer takes; None: the default of the first frame.
       max_side: run frames downsized to this longer side, pixels (default: the working size of the samples).
       mirror: average a learned model's estimate with that of the mirror-image frame (lipjax.inference.mirror_averaged:
-        more accurate, twice the model's work).
+        more accurate, twice the model's work); None: on LiDAR scan lines (lipjax.inference.mirrors).
       cross_check: check a learned model against the linear fill on held-out samples (lipjax.crosscheck).
       ply, intrinsics: also write a coloured point cloud (metres), with the RGB camera's intrinsics (pixels: an
         Intrinsics, (fx, fy, cx, cy), K, or a file lipjax.data.folder.read_intrinsics reads; a sweep's calibration

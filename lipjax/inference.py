@@ -121,13 +121,13 @@ def default_model(scene: str = "indoor") -> Completer:
 
 
 # Whether the default path (`complete_at`, `lipjax.complete`, `lipjax complete`, the ONNX graph) averages a learned
-# model's estimate with that of the mirror-image frame (`mirror_averaged`). Off: with the 228,000-image lip-any it is
-# more accurate (`benchmarks/generalisation.py --frames 8`: 0.7755 -> 0.7661 x linear, every setting better but far
-# views, 0.958 -> 0.964) but takes twice the model's work (benchmarks/speed.py, as one batch of two: 480x640 with
-# 200 points 62 -> 117 ms, 17.7 -> 9.6 frames/s normalised; 352x1216 with 64 beams 75 -> 139 ms), below the 10
-# frames/s the default path keeps (since run in two threads on the CPU: 352x1216 34 -> 40 ms, 480x640 with the check
-# 36 -> 61 ms). Opt in with `mirror=True` (`lipjax complete --mirror`). Training and evaluation call the model itself.
-MIRROR_AVERAGE = False
+# model's estimate with that of the mirror-image frame (`mirror_averaged`) where the caller does not say
+# (mirror=None): on LiDAR scan lines, where the check against the linear fill (lipjax.crosscheck) does not run and
+# leaves the second core free (rule 54 of docs/design-notes.md: the 1,260,640-image lip-any's synthetic suite 0.6350
+# -> 0.6323 x linear, streets with HDL-64 0.404 -> 0.391; the 352x1216 street in two threads 34 -> 40 ms). Not on
+# scattered samples: there the check's held-out fold takes that core (480x640 with 200 points 36 -> 61 ms with both).
+# `mirror=True` / `--mirror` asks for it on any input, `mirror=False` / `--no-mirror` nowhere.
+MIRROR_SCAN_LINES = True
 # Threads that run the mirror image's estimate beside the frame's (`mirror_averaged`, on the CPU): a pool of its own,
 # as a held-out fold running in lipjax.crosscheck's threads asks for one (its tasks wait on nothing, so a full pool
 # only queues them); one per fold and one for the frame.
@@ -193,7 +193,7 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
-                   mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK) -> np.ndarray:
+                   mirror: bool | None = None, cross_check: bool = CROSS_CHECK) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`);
     `max_side` caps the longer side instead (pixels), `mirror` and `cross_check` as in `complete_at`."""
     return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror,
@@ -229,8 +229,16 @@ def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray)
     return 0.5 * (z + mirrored.result()[:, ::-1])
 
 
+def mirrors(completer, sparse_m: np.ndarray, mirror: bool | None) -> bool:
+    """Whether the default path averages `completer`'s estimate of the (H, W) sparse map (metres) with the mirror
+    image's: `mirror` where it is given, else (None) for a learned model on LiDAR scan lines (MIRROR_SCAN_LINES)."""
+    if mirror is not None:
+        return mirror
+    return MIRROR_SCAN_LINES and isinstance(completer, Completer) and is_lidar_pattern(sparse_m)
+
+
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
-                mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK,
+                mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
                 spread: bool = SPREAD_RESIDUALS) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
@@ -240,9 +248,10 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     x-update runs at full size: with rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets
     every measured pixel back to its measured value (the model's own last x-update, with its learned rho, keeps
     them only approximately).
-    With `mirror` a learned model's estimate is `mirror_averaged` (MIRROR_AVERAGE: the default, and why). With
-    `cross_check` (CROSS_CHECK) a learned model's estimate of scattered samples is checked against the linear fill
-    on held-out samples and blended with it where it is the worse (`lipjax.crosscheck.cross_checked`).
+    With `mirror` a learned model's estimate is `mirror_averaged`; None (the default) does so on LiDAR scan lines
+    (`mirrors`; MIRROR_SCAN_LINES says why). With `cross_check` (CROSS_CHECK) a learned model's estimate of
+    scattered samples is checked against the linear fill on held-out samples and blended with it where it is the
+    worse (`lipjax.crosscheck.cross_checked`).
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
     bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
     linear on 352x1216 streets with 64 beams.)
@@ -258,7 +267,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
-    run = functools.partial(mirror_averaged, completer) if mirror else completer
+    run = functools.partial(mirror_averaged, completer) if mirrors(completer, sparse_m, mirror) else completer
     scan_lines = spread and (h, w) != (big_h, big_w) and is_lidar_pattern(sparse_m)  # the spread's sigmas
 
     def estimate(sparse: np.ndarray, at: tuple[int, int]) -> np.ndarray:  # z (H, W) from a sparse map, run at `at`

@@ -33,7 +33,7 @@ from lipjax.classical import (
 )
 from lipjax.interfaces import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
-from lipjax.inference import CROSS_CHECK, MIRROR_AVERAGE, Completer, complete_frame, default_model, load_model
+from lipjax.inference import CROSS_CHECK, Completer, complete_frame, default_model, load_model
 from lipjax.inputs import suggest_scene
 from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
@@ -87,15 +87,16 @@ def available_methods(scene: str) -> list[str]:
 
 
 def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_uncertainty: float | None = None,
-             return_uncertainty: bool = False, mirror: bool = MIRROR_AVERAGE, cross_check: bool = CROSS_CHECK):
+             return_uncertainty: bool = False, mirror: bool | None = None, cross_check: bool = CROSS_CHECK):
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
     `model`: anything `get_completer` takes; by default the shipped default model, indoor or outdoor as the samples
     suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`);
-    `mirror` also runs it on the mirror-image frame and averages (more accurate, twice the model's work;
-    MIRROR_AVERAGE); `cross_check` checks it against the linear fill on held-out samples (lipjax.crosscheck;
-    CROSS_CHECK). With `max_uncertainty` (metres), depth is 0 (none) where the expected absolute error
-    (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns (depth, expected error m).
+    `mirror` also runs it on the mirror-image frame and averages (more accurate, twice the model's work; None: on
+    LiDAR scan lines, lipjax.inference.mirrors); `cross_check` checks it against the linear fill on held-out
+    samples (lipjax.crosscheck; CROSS_CHECK). With `max_uncertainty` (metres), depth is 0 (none) where the
+    expected absolute error (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns
+    (depth, expected error m).
     """
     completer = get_completer(model, sparse=sparse)
     rgb, sparse = np.asarray(rgb), np.asarray(sparse)

@@ -37,9 +37,10 @@ than the one lipjax trains with, see that module):
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
      (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured
-     pixels set back to their measured values. With `mirror=True` (`lipjax export --mirror`) the frames and their
-     mirror images run as one batch of 2B, and each frame's two estimates are averaged after flipping the second
-     back, as `lipjax.complete(..., mirror=True)` does.
+     pixels set back to their measured values. For LiDAR scan lines (and with `mirror=True`, `lipjax export
+     --mirror`, for scattered samples) the frames and their mirror images run as one batch of 2B, and each frame's
+     two estimates are averaged after flipping the second back, as `lipjax.complete` does on scan lines (rule 54
+     of docs/design-notes.md; `--no-mirror` leaves it out, at half the model's work).
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
 of the model against the linear fill on held-out samples (lipjax.crosscheck; scattered samples only) is not in the
 graph (it needs the Delaunay fill): the graph is `lipjax.complete(..., cross_check=False)`. No input
@@ -61,7 +62,7 @@ import jax.numpy as jnp
 
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import MIRROR_AVERAGE, SPREAD_RESIDUALS, Completer
+from lipjax.inference import MIRROR_SCAN_LINES, SPREAD_RESIDUALS, Completer
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import dense_from, is_capped, working_size
@@ -111,18 +112,18 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
 
 
 def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int], *,
-                    mirror: bool = MIRROR_AVERAGE, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
+                    mirror: bool | None = None, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
     graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
-    average with the mirror-image frame as lipjax.complete does (lipjax.inference.MIRROR_AVERAGE); `spread`: spread
-    the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS), with the sigmas
-    of LiDAR scan lines or (`scan_lines=False`) of scattered samples (lipjax.spread.spread_sigmas_px)."""
+    average with the mirror-image frame as lipjax.complete does (None: on scan lines, `graph_mirrors`); `spread`:
+    spread the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS), with the
+    sigmas of LiDAR scan lines or (`scan_lines=False`) of scattered samples (lipjax.spread.spread_sigmas_px)."""
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
     unknown = set(config.host_input_names) - {"z0"}
     if unknown:
         raise ValueError(f"{completer.name} needs host inputs {sorted(unknown)} that have no in-graph version")
-    resized = tuple(working) != tuple(frame)
+    resized, mirror = tuple(working) != tuple(frame), graph_mirrors(mirror, scan_lines)
 
     def model(rgb, sparse):
         extra = {name: jump_flood_nearest(sparse) for name in config.host_input_names}
@@ -144,6 +145,12 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
         return jnp.where(sparse > 0, sparse, depth)
 
     return run
+
+
+def graph_mirrors(mirror: bool | None, scan_lines: bool) -> bool:
+    """Whether the graph averages with the mirror image: `mirror` where it is given, else (None) as lipjax.complete
+    does by default (lipjax.inference.mirrors): on LiDAR scan lines, not on scattered samples."""
+    return MIRROR_SCAN_LINES and scan_lines if mirror is None else mirror
 
 
 def _host_fill(config) -> str | None:
@@ -185,8 +192,8 @@ class OnnxFile:
             lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
                          "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
         if self.mirror:
-            lines.append("mirror averaging in the graph: equal to lipjax.complete(..., mirror=True, "
-                         "cross_check=False)")
+            lines.append("mirror averaging in the graph (--no-mirror: without, at half the work): equal to "
+                         "lipjax.complete(..., mirror=True, cross_check=False)")
         return "\n".join(lines)
 
 
@@ -199,10 +206,10 @@ def need_onnx() -> None:
 
 
 def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
-                samples: int | None = None, scan_lines: bool = True, mirror: bool = MIRROR_AVERAGE) -> OnnxFile:
+                samples: int | None = None, scan_lines: bool = True, mirror: bool | None = None) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
     `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`; `mirror` as
-    lipjax.complete(..., mirror=True). ImportError without the onnx package."""
+    lipjax.complete's (None: on scan lines, `graph_mirrors`). ImportError without the onnx package."""
     need_onnx()
     import onnx
 
@@ -210,6 +217,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
         if int(value) < 1:
             raise ValueError(f"{name} must be >= 1, got {value}")
     samples = default_samples(height, width) if samples is None else samples
+    mirror = graph_mirrors(mirror, scan_lines)
     working = export_working_size(height, width, samples, scan_lines)
     interval = samples_interval(height, width, samples, scan_lines)
     replaced = _host_fill(completer.config)

@@ -88,11 +88,15 @@ def test_npy_in_npy_out_metres_equals_library(model, frame, tmp_path):
     np.testing.assert_allclose(out, complete_frame(model[1], frame["rgb_array"], frame["sparse_array"]), rtol=1e-6)
 
 
-def test_mirror_flag_equals_the_library_with_mirror(model, frame, tmp_path):
-    assert _complete(model, frame, tmp_path / "out.npy", "--mirror") == 0
-    out, rgb, sparse = np.load(tmp_path / "out.npy"), frame["rgb_array"], frame["sparse_array"]
-    np.testing.assert_allclose(out, complete_frame(model[1], rgb, sparse, mirror=True), rtol=1e-6)
-    assert np.abs(out - complete_frame(model[1], rgb, sparse)).max() > 1e-3
+def test_mirror_flags_equal_the_library_with_mirror_on_and_off(model, frame, tmp_path):
+    """--mirror and --no-mirror are mirror=True and False (the default, None, mirrors scan lines only)."""
+    rgb, sparse = frame["rgb_array"], frame["sparse_array"]
+    assert _complete(model, frame, tmp_path / "on.npy", "--mirror") == 0
+    assert _complete(model, frame, tmp_path / "off.npy", "--no-mirror") == 0
+    on, off = np.load(tmp_path / "on.npy"), np.load(tmp_path / "off.npy")
+    np.testing.assert_allclose(on, complete_frame(model[1], rgb, sparse, mirror=True), rtol=1e-6)
+    np.testing.assert_allclose(off, complete_frame(model[1], rgb, sparse, mirror=False), rtol=1e-6)
+    assert np.abs(on - off).max() > 1e-3
 
 
 def test_color_png_and_ply_outputs(model, frame, tmp_path):

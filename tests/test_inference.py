@@ -222,6 +222,34 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
 
 
 @pytest.mark.filterwarnings("ignore:samples in LiDAR scan lines")  # a tiny model trained on neither
+def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
+    """mirror=None (the default of complete_at, lipjax.complete): averaged with the mirror image on LiDAR scan lines,
+    where the check does not run (rule 54), and not on scattered samples; True and False force it either way; a
+    classical fill is never mirrored by default."""
+    from lipjax.inference import complete_at, is_lidar_pattern, mirrors
+
+    completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
+    rng = np.random.default_rng(8)
+    rgb = rng.integers(0, 256, (40, 56, 3), dtype=np.uint8)
+    lines = np.zeros((40, 56), np.float32)
+    lines[1::4] = np.where(rng.random((10, 56)) < 0.8, rng.uniform(1, 8, (10, 56)), 0)
+    scattered = np.where(rng.random((40, 56)) < 0.05, rng.uniform(1, 8, (40, 56)), 0).astype(np.float32)
+    assert is_lidar_pattern(lines) and not is_lidar_pattern(scattered)
+    for size in ((40, 56), (20, 28)):
+        def run(sparse, mirror=None):
+            return complete_at(completer, rgb, sparse, size, mirror=mirror, cross_check=False)
+
+        np.testing.assert_array_equal(run(lines), run(lines, True))
+        assert np.abs(run(lines) - run(lines, False)).max() > 1e-3
+        np.testing.assert_array_equal(run(scattered), run(scattered, False))
+        assert np.abs(run(scattered) - run(scattered, True)).max() > 1e-3
+    np.testing.assert_array_equal(lipjax.complete(rgb, lines, model=completer),
+                                  lipjax.complete(rgb, lines, model=completer, mirror=True))
+    assert not mirrors(methods.get_completer("linear"), lines, None) and mirrors(completer, lines, None)
+    np.testing.assert_array_equal(lipjax.complete(rgb, lines, model="linear"), linear_fill(lines))
+
+
+@pytest.mark.filterwarnings("ignore:samples in LiDAR scan lines")  # a tiny model trained on neither
 def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estimate():
     """complete_at(spread=True) at a working size: z resized back (bilinear), then lipjax.spread.spread_residuals with
     half a working pixel (scattered samples; scan lines with their own sigmas), then the measured pixels set back; at
@@ -253,5 +281,6 @@ def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estim
     z = cv2.resize(np.asarray(small, np.float32), (56, 40), interpolation=cv2.INTER_LINEAR)
     expected = spread_on_host(z, lines, (20, 28), scan_lines=True)
     expected[lines > 0] = lines[lines > 0]
-    np.testing.assert_allclose(complete_at(completer, rgb, lines, (20, 28)), expected, rtol=1e-5, atol=1e-5)
+    got = complete_at(completer, rgb, lines, (20, 28), mirror=False)  # one run: the spread alone
+    np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-5)
     assert np.abs(spread_on_host(z, lines, (20, 28)) - expected)[lines == 0].max() > 1e-3

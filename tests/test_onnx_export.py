@@ -96,15 +96,15 @@ def auto_model():
     return perturbed(c)
 
 
-@pytest.mark.parametrize("mirror", [False, True])
+@pytest.mark.parametrize("mirror", [None, False, True])
 def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path, mirror):
     """128x160 with 10 points runs at 64x80 (area resize, reprojection, bilinear back): scattered points, so
     lipjax.complete fills linearly and the graph equals the model's nearest twin, not the model itself; with and
-    without mirror averaging."""
+    without mirror averaging, and by default (None) without it, as complete on scattered points."""
     h, w = 128, 160
     written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, scan_lines=False,
                           mirror=mirror)
-    assert written.working == (64, 80) and written.replaced_fill == "auto"
+    assert written.working == (64, 80) and written.replaced_fill == "auto" and written.mirror == bool(mirror)
     assert "instead of the model's 'auto'" in written.summary() and "64x80" in written.summary()
     rng = np.random.default_rng(3)
     rgb = rng.integers(0, 256, (1, h, w, 3), dtype=np.uint8)
@@ -165,22 +165,29 @@ def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_pa
         export("linear", tmp_path / "m.stablehlo", height=8, width=8, **option)
 
 
-def test_a_mirror_averaged_export_equals_complete_with_mirror(auto_model, tmp_path):
-    """export_onnx(mirror=True) holds the frame and its mirror image in one batch (lax.rev as ONNX Slice with step
-    -1) and equals lipjax.complete(..., mirror=True), which differs from the plain export."""
+def test_a_scan_line_export_averages_with_the_mirror_image_as_complete_does(auto_model, tmp_path):
+    """export_onnx on LiDAR scan lines holds the frame and its mirror image in one batch (lax.rev as ONNX Slice with
+    step -1), by default as with mirror=True, and equals lipjax.complete's default path there, which averages with
+    the mirror image on scan lines (rule 54); mirror=False (--no-mirror) leaves it out, as complete does."""
     b, h, w = 2, 48, 64
-    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b, mirror=True)
-    plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b)
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b)
+    plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b, mirror=False)
     rng = np.random.default_rng(6)
     rgb = rng.integers(0, 256, (b, h, w, 3), dtype=np.uint8)
     sparse = np.zeros((b, h, w), np.float32)
     sparse[:, 1::3] = np.where(rng.random((b, 16, w)) < 0.7, rng.uniform(2, 9, (b, 16, w)), 0)
+    assert all(is_lidar_pattern(s) for s in sparse)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    expected = np.stack([lipjax.complete(c, s, model=auto_model, mirror=True) for c, s in zip(rgb, sparse)])
+    expected = np.stack([lipjax.complete(c, s, model=auto_model) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
+    np.testing.assert_array_equal(expected, [lipjax.complete(c, s, model=auto_model, mirror=True)
+                                             for c, s in zip(rgb, sparse)])
     without, = _run_onnx(str(plain.path), rgb=rgb, sparse=sparse)
+    np.testing.assert_allclose(without, [lipjax.complete(c, s, model=auto_model, mirror=False)
+                                         for c, s in zip(rgb, sparse)], rtol=1e-5, atol=1e-4)
     assert np.abs(got - without).max() > 1e-3
     import onnx
 
     assert {p.key: p.value for p in onnx.load(str(written.path)).metadata_props}["mirror_averaged"] == "true"
+    assert {p.key: p.value for p in onnx.load(str(plain.path)).metadata_props}["mirror_averaged"] == "false"
     assert "mirror averaging in the graph" in written.summary() and "mirror averaging" not in plain.summary()
