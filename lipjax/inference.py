@@ -229,12 +229,13 @@ def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray)
     return 0.5 * (z + mirrored.result()[:, ::-1])
 
 
-def mirrors(completer, sparse_m: np.ndarray, mirror: bool | None) -> bool:
-    """Whether the default path averages `completer`'s estimate of the (H, W) sparse map (metres) with the mirror
-    image's: `mirror` where it is given, else (None) for a learned model on LiDAR scan lines (MIRROR_SCAN_LINES)."""
+def mirrors(completer, scan_lines: bool, mirror: bool | None) -> bool:
+    """Whether the default path averages `completer`'s estimate of a frame with the mirror image's: `mirror` where
+    it is given, else (None) for a learned model on LiDAR scan lines (`scan_lines`: lipjax.inputs.is_lidar_pattern
+    of the frame's samples; MIRROR_SCAN_LINES)."""
     if mirror is not None:
         return mirror
-    return MIRROR_SCAN_LINES and isinstance(completer, Completer) and is_lidar_pattern(sparse_m)
+    return MIRROR_SCAN_LINES and scan_lines and isinstance(completer, Completer)
 
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
@@ -267,8 +268,9 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
-    run = functools.partial(mirror_averaged, completer) if mirrors(completer, sparse_m, mirror) else completer
-    scan_lines = spread and (h, w) != (big_h, big_w) and is_lidar_pattern(sparse_m)  # the spread's sigmas
+    lines = is_lidar_pattern(sparse_m)  # asked once: the mirror image, the spread's sigmas, the check
+    run = functools.partial(mirror_averaged, completer) if mirrors(completer, lines, mirror) else completer
+    scan_lines = spread and (h, w) != (big_h, big_w) and lines  # the spread's sigmas
 
     def estimate(sparse: np.ndarray, at: tuple[int, int]) -> np.ndarray:  # z (H, W) from a sparse map, run at `at`
         if at == (big_h, big_w):
@@ -278,7 +280,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
         return spread_on_host(z, sparse, at, scan_lines) if spread else z  # before any set-back
 
-    if cross_check and isinstance(completer, Completer):
+    if cross_check and isinstance(completer, Completer) and not lines:  # scan lines are never checked
         dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w))
     else:
         dense = estimate(sparse_m, (h, w))

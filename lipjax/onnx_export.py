@@ -62,7 +62,7 @@ import jax.numpy as jnp
 
 from lipjax import jaxpr_to_onnx
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import MIRROR_SCAN_LINES, SPREAD_RESIDUALS, Completer
+from lipjax.inference import SPREAD_RESIDUALS, Completer, mirrors
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import dense_from, is_capped, working_size
@@ -115,15 +115,16 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
                     mirror: bool | None = None, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
     graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
-    average with the mirror-image frame as lipjax.complete does (None: on scan lines, `graph_mirrors`); `spread`:
-    spread the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS), with the
-    sigmas of LiDAR scan lines or (`scan_lines=False`) of scattered samples (lipjax.spread.spread_sigmas_px)."""
+    average with the mirror-image frame as lipjax.complete does (None: on scan lines, lipjax.inference.mirrors);
+    `spread`: spread the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS),
+    with the sigmas of LiDAR scan lines or (`scan_lines=False`) of scattered samples
+    (lipjax.spread.spread_sigmas_px)."""
     config = completer.config
     params = jax.tree_util.tree_map(jnp.asarray, completer.params)
     unknown = set(config.host_input_names) - {"z0"}
     if unknown:
         raise ValueError(f"{completer.name} needs host inputs {sorted(unknown)} that have no in-graph version")
-    resized, mirror = tuple(working) != tuple(frame), graph_mirrors(mirror, scan_lines)
+    resized, mirror = tuple(working) != tuple(frame), mirrors(completer, scan_lines, mirror)
 
     def model(rgb, sparse):
         extra = {name: jump_flood_nearest(sparse) for name in config.host_input_names}
@@ -145,12 +146,6 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
         return jnp.where(sparse > 0, sparse, depth)
 
     return run
-
-
-def graph_mirrors(mirror: bool | None, scan_lines: bool) -> bool:
-    """Whether the graph averages with the mirror image: `mirror` where it is given, else (None) as lipjax.complete
-    does by default (lipjax.inference.mirrors): on LiDAR scan lines, not on scattered samples."""
-    return MIRROR_SCAN_LINES and scan_lines if mirror is None else mirror
 
 
 def _host_fill(config) -> str | None:
@@ -209,7 +204,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
                 samples: int | None = None, scan_lines: bool = True, mirror: bool | None = None) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
     `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`; `mirror` as
-    lipjax.complete's (None: on scan lines, `graph_mirrors`). ImportError without the onnx package."""
+    lipjax.complete's (None: on scan lines, lipjax.inference.mirrors). ImportError without the onnx package."""
     need_onnx()
     import onnx
 
@@ -217,7 +212,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
         if int(value) < 1:
             raise ValueError(f"{name} must be >= 1, got {value}")
     samples = default_samples(height, width) if samples is None else samples
-    mirror = graph_mirrors(mirror, scan_lines)
+    mirror = mirrors(completer, scan_lines, mirror)
     working = export_working_size(height, width, samples, scan_lines)
     interval = samples_interval(height, width, samples, scan_lines)
     replaced = _host_fill(completer.config)

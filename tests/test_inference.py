@@ -245,7 +245,7 @@ def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
         assert np.abs(run(scattered) - run(scattered, True)).max() > 1e-3
     np.testing.assert_array_equal(lipjax.complete(rgb, lines, model=completer),
                                   lipjax.complete(rgb, lines, model=completer, mirror=True))
-    assert not mirrors(methods.get_completer("linear"), lines, None) and mirrors(completer, lines, None)
+    assert not mirrors(methods.get_completer("linear"), True, None) and mirrors(completer, True, None)
     np.testing.assert_array_equal(lipjax.complete(rgb, lines, model="linear"), linear_fill(lines))
 
 
