@@ -15,10 +15,13 @@ post-processes (uncertainty, the support mask) and writes each completed frame, 
 compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames (`python
 benchmarks/folder_speed.py --keep DIR`, lip-any at 132x455) on the 2-core machine with training paused, a folder ran
 at 1.06-1.18x the warm single-frame rate (3 runs; single frame 32-35 ms); one frame at a time it ran at 0.86-0.90x in
-the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Per frame a folder adds 17.5 ms of CPU that one
-frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1. Every output file is written under a
-temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a failing frame (an unreadable file,
-a full disk) leaves the frames before it written whole and nothing of itself or the frames after it.
+the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Since the default path averages in the mirror
+image on scan lines (lipjax.inference.mirrors), each frame keeps both cores busy itself, and the folder ran at
+0.82-0.89x (3 runs; single frame 38-41 ms), 0.82-0.85x one frame at a time (2 runs, interleaved). Per frame a folder
+adds 17.5 ms of CPU that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1. Every
+output file is written under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a
+failing frame (an unreadable file, a full disk) leaves the frames before it written whole and nothing of itself or the
+frames after it.
 """
 from __future__ import annotations
 
