@@ -2,8 +2,9 @@
 
 Run by hand (never a test; the frames are research-use data read from ../shared/realdata, never copied):
 
-    python benchmarks/real_frames.py [--model NAME] [--realdata ../shared/realdata] [--json out.json] [--mirror]
-                                     [--sweep] [--plot docs/results/real_frames_working_res.png]
+    python benchmarks/real_frames.py [--model NAME] [--realdata ../shared/realdata] [--json out.json]
+                                     [--mirror | --no-mirror] [--sweep]
+                                     [--plot docs/results/real_frames_working_res.png]
 
 Frames at their native size: NYU v2 (3, 480x640), KITTI (3, 375x1242), Middlebury 2014 Motorcycle (1, 497x741),
 lingbot (8, 480x640, raw consumer RGB-D depth). Inputs drawn from the valid ground truth with seed 0 and the frame
@@ -109,9 +110,8 @@ def main(argv=None) -> None:
             row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
         if args.sweep:
             spacing, lines = sample_spacing_px(sparse), is_lidar_pattern(sparse)
-            row["sweep"] = {
-                str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(sample.shape, spacing, t, lines)),
-                             sample, sparse) / ref for t in SWEEP_TARGETS_PX}
+            row["sweep"] = {str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(
+                sample.shape, spacing, t, lines), mirror=args.mirror), sample, sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
         print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "

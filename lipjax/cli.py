@@ -2,14 +2,14 @@
 fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
-                    [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)]
-                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--mirror] [--no-cross-check] [--threads N]
+                    [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)] [--threads N]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--[no-]mirror] [--no-cross-check]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model NAME|PATH] --height H --width W [--batch B] [--samples N] [--scattered] [--mirror] --out F
+    lipjax export [--model M] --height H --width W [--batch B] [--samples N] [--scattered] [--[no-]mirror] --out F
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]  (fine-tune on your frames)
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
@@ -154,7 +154,7 @@ def _add_complete_parser(sub) -> None:
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
-    c.add_argument("--mirror", action=_BOOL, help="average with the mirror image (2x work; default: on scan lines)")
+    c.add_argument("--mirror", action=_BOOL, help="learned models: average in the mirror image (default: scan lines)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
                    help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")

@@ -338,7 +338,7 @@ def model_threads(completer: Any) -> int:
 
 
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
-         max_side: int | None, mirror: bool, cross_check: bool, progress: bool,
+         max_side: int | None, mirror: bool | None, cross_check: bool, progress: bool,
          log: Callable[[str], None] | None, workers: int) -> None:
     """Reads (prefetched), completes and writes (`_Writer`) every job of the plan, in order: the first frame in
     this thread, then `model_threads` frames at a time in threads of their own, whose warnings are shown from this

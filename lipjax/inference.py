@@ -124,7 +124,7 @@ def default_model(scene: str = "indoor") -> Completer:
 # model's estimate with that of the mirror-image frame (`mirror_averaged`) where the caller does not say
 # (mirror=None): on LiDAR scan lines, where the check against the linear fill (lipjax.crosscheck) does not run and
 # leaves the second core free (rule 54 of docs/design-notes.md: the 1,260,640-image lip-any's synthetic suite 0.6350
-# -> 0.6323 x linear, streets with HDL-64 0.404 -> 0.391; the 352x1216 street in two threads 34 -> 40 ms). Not on
+# -> 0.6323 x linear, streets with HDL-64 0.404 -> 0.391; the 352x1216 street in two threads 37 -> 42 ms). Not on
 # scattered samples: there the check's held-out fold takes that core (480x640 with 200 points 36 -> 61 ms with both).
 # `mirror=True` / `--mirror` asks for it on any input, `mirror=False` / `--no-mirror` nowhere.
 MIRROR_SCAN_LINES = True
@@ -268,7 +268,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
-    lines = is_lidar_pattern(sparse_m)  # asked once: the mirror image, the spread's sigmas, the check
+    lines = is_lidar_pattern(sparse_m)  # for the mirror image, the spread's sigmas and the check (never on lines)
     run = functools.partial(mirror_averaged, completer) if mirrors(completer, lines, mirror) else completer
     scan_lines = spread and (h, w) != (big_h, big_w) and lines  # the spread's sigmas
 

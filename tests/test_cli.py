@@ -97,6 +97,10 @@ def test_mirror_flags_equal_the_library_with_mirror_on_and_off(model, frame, tmp
     np.testing.assert_allclose(on, complete_frame(model[1], rgb, sparse, mirror=True), rtol=1e-6)
     np.testing.assert_allclose(off, complete_frame(model[1], rgb, sparse, mirror=False), rtol=1e-6)
     assert np.abs(on - off).max() > 1e-3
+    no_flag = (["complete", "--rgb", "a.png", "--out", "b.npy"], ["export", "--height", "8", "--width", "8",
+                                                                   "--out", "m.onnx"])
+    for command in no_flag:
+        assert cli.build_parser().parse_args(command).mirror is None  # no flag: the library's default decides
 
 
 def test_color_png_and_ply_outputs(model, frame, tmp_path):

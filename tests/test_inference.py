@@ -185,8 +185,8 @@ def test_auto_initial_estimate_is_nearest_on_scan_lines_and_linear_on_scattered_
 
 def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the_estimate(monkeypatch):
     """mirror_averaged(I, y) = (z(I, y) + flip(z(flip I, flip y))) / 2 is exactly flip-equivariant, which one call
-    of a network is not; the default path (complete_at, lipjax.complete) uses it on request (mirror=True) at full
-    and at working size."""
+    of a network is not; the default path (complete_at, lipjax.complete) uses it on request (mirror=True; by
+    default on scan lines only) at full and at working size."""
     from lipjax.inference import complete_at, mirror_averaged
 
     completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
@@ -206,7 +206,7 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
     np.testing.assert_allclose(batched, averaged, rtol=0, atol=1e-3)  # measured 2e-4 m
     for size in ((40, 56), (20, 28)):
         got = complete_at(completer, rgb, sparse, size, mirror=True)
-        assert np.abs(got - complete_at(completer, rgb, sparse, size)).max() > 1e-3  # off by default
+        assert np.abs(got - complete_at(completer, rgb, sparse, size)).max() > 1e-3  # off on scattered
     for size in ((40, 56), (20, 28)):  # at any size the measured pixels are set back (the model's x keeps them ~)
         for mirror in (False, True):
             got = complete_at(completer, rgb, sparse, size, mirror=mirror)

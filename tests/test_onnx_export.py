@@ -124,9 +124,9 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
 
 def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_model, tmp_path):
     """A 48x64 frame runs at full size (no resize in the graph); on scan lines "auto" is the nearest fill, so the
-    exported batch of two equals lipjax.complete frame by frame."""
+    exported batch of two equals lipjax.complete frame by frame (both without the mirror image: the fill alone)."""
     b, h, w = 2, 48, 64
-    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b)
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b, mirror=False)
     assert written.working == (h, w) and written.shape == (b, h, w)
     rng = np.random.default_rng(4)
     rgb = rng.integers(0, 256, (b, h, w, 3), dtype=np.uint8)
@@ -134,13 +134,14 @@ def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_mo
     sparse[:, 1::3] = np.where(rng.random((b, 16, w)) < 0.7, rng.uniform(2, 9, (b, 16, w)), 0)
     assert all(is_lidar_pattern(s) for s in sparse)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    expected = np.stack([lipjax.complete(c, s, model=auto_model) for c, s in zip(rgb, sparse)])
+    expected = np.stack([lipjax.complete(c, s, model=auto_model, mirror=False) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
 
 
 def test_the_graph_spreads_scan_lines_with_their_own_sigmas_as_complete_does(auto_model):
     """A 48x64 scan at a 24x32 working size: the jax graph (scan_lines=True) equals complete_at, whose spread uses
-    the scan-line sigmas (lipjax.spread.SCAN_LINE_SIGMAS_WORKING_PX) for this input; scattered sigmas differ."""
+    the scan-line sigmas (lipjax.spread.SCAN_LINE_SIGMAS_WORKING_PX) for this input; scattered sigmas differ (all
+    three without the mirror image, so that only the sigmas can tell them apart)."""
     from lipjax.inference import complete_at
 
     h, w = 48, 64
@@ -149,9 +150,9 @@ def test_the_graph_spreads_scan_lines_with_their_own_sigmas_as_complete_does(aut
     sparse = np.zeros((1, h, w), np.float32)
     sparse[:, 1::4] = np.where(rng.random((1, 12, w)) < 0.8, rng.uniform(2, 9, (1, 12, w)), 0)
     assert is_lidar_pattern(sparse[0])
-    host = complete_at(auto_model, rgb[0], sparse[0], (24, 32))
-    lines, scattered = (np.asarray(jax.jit(inference_graph(auto_model, (h, w), (24, 32), scan_lines=s))(rgb, sparse))
-                        for s in (True, False))
+    host = complete_at(auto_model, rgb[0], sparse[0], (24, 32), mirror=False)
+    lines, scattered = (np.asarray(jax.jit(inference_graph(auto_model, (h, w), (24, 32), mirror=False,
+                                                           scan_lines=s))(rgb, sparse)) for s in (True, False))
     np.testing.assert_allclose(lines[0], host, rtol=1e-5, atol=1e-4)
     assert np.abs(scattered[0] - host).max() > 1e-3
 
