@@ -55,11 +55,13 @@ SEED = 0  # which samples fall in which fold: fixed, so that a frame always give
 _FOLDS_BESIDE = ThreadPoolExecutor(max_workers=FOLDS - 1, thread_name_prefix="lipjax-crosscheck")
 
 
-def applies(sparse_m: np.ndarray) -> bool:
+def applies(sparse_m: np.ndarray, scan_lines: bool | None = None) -> bool:
     """Whether a (H, W) sparse map (metres, 0 = none) is checked: >= MIN_SAMPLES samples, at most DENSE per pixel,
-    not LiDAR scan lines."""
+    not LiDAR scan lines (`scan_lines`: is_lidar_pattern of the map, asked here when not given)."""
     n = int(np.count_nonzero(sparse_m > 0))
-    return MIN_SAMPLES <= n < dense_from(sparse_m.size) and not is_lidar_pattern(sparse_m)
+    if not MIN_SAMPLES <= n < dense_from(sparse_m.size):
+        return False
+    return not (is_lidar_pattern(sparse_m) if scan_lines is None else scan_lines)
 
 
 def fold_out(sparse_m: np.ndarray, folds: int = FOLDS, seed: int = SEED) -> Iterator[tuple]:
@@ -102,13 +104,13 @@ def blend_weight(y: np.ndarray, x_m: np.ndarray, x_l: np.ndarray, p_value: float
 
 
 def cross_checked(estimate: Callable[[np.ndarray, tuple[int, int]], np.ndarray], sparse_m: np.ndarray,
-                  size: tuple[int, int]) -> tuple[np.ndarray, float]:
+                  size: tuple[int, int], scan_lines: bool | None = None) -> tuple[np.ndarray, float]:
     """(x, w): z = estimate(sparse_m, size), the model's (H, W) estimate from every sample of `sparse_m` (metres)
     run at working size `size` (h, w), blended with the linear fill as the module doc says; each fold's estimate
     from its kept samples is estimate(kept, held_out_size(size, sparse_m)), run in other threads (the first fold
     beside z's). Measured pixels are not set back here (the caller's final x-update does it). A map the check does
-    not apply to (`applies`) gives (z, 1.0)."""
-    if not applies(sparse_m):
+    not apply to (`applies`, given `scan_lines` when the caller knows it) gives (z, 1.0)."""
+    if not applies(sparse_m, scan_lines):
         return estimate(sparse_m, size), 1.0
     at = held_out_size(size, sparse_m)
     folds = fold_out(sparse_m)

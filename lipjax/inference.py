@@ -268,7 +268,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
-    lines = is_lidar_pattern(sparse_m)  # for the mirror image, the spread's sigmas and the check (never on lines)
+    lines = is_lidar_pattern(sparse_m)  # asked once here: the mirror image, the spread's sigmas, the check
     run = functools.partial(mirror_averaged, completer) if mirrors(completer, lines, mirror) else completer
     scan_lines = spread and (h, w) != (big_h, big_w) and lines  # the spread's sigmas
 
@@ -280,8 +280,8 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
         return spread_on_host(z, sparse, at, scan_lines) if spread else z  # before any set-back
 
-    if cross_check and isinstance(completer, Completer) and not lines:  # scan lines are never checked
-        dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w))
+    if cross_check and isinstance(completer, Completer):
+        dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w), scan_lines=lines)
     else:
         dense = estimate(sparse_m, (h, w))
     measured = sparse_m > 0

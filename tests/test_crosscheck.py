@@ -86,6 +86,8 @@ def test_it_applies_to_100_scattered_samples_or_more_and_never_to_scan_lines():
     lines = np.zeros_like(depth)
     lines[2::4] = depth[2::4]  # 12 full rows: 768 samples
     assert not crosscheck.applies(lines)
+    assert crosscheck.applies(lines, scan_lines=False)  # a caller that knew the pattern (complete_at) is believed
+    assert not crosscheck.applies(_scattered(depth, crosscheck.MIN_SAMPLES), scan_lines=True)
 
 
 def test_a_wrong_estimate_gives_way_to_the_linear_fill_and_a_right_one_is_kept():
