@@ -164,10 +164,11 @@ def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     sparse = np.asarray(sparse_m, np.float32)
     big_h, big_w = sparse.shape
     h, w = size
-    rows, cols = np.nonzero(sparse > 0)
+    flat = np.flatnonzero(sparse > 0)  # not np.nonzero: several times faster on a KITTI frame
+    rows, cols = np.divmod(flat, big_w)
     r = np.minimum(((rows + 0.5) * h / big_h).astype(np.int64), h - 1)
     c = np.minimum(((cols + 0.5) * w / big_w).astype(np.int64), w - 1)
-    return splat_nearest(r * w + c, sparse[rows, cols], (h, w))
+    return splat_nearest(r * w + c, sparse.ravel()[flat], (h, w))
 
 
 def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> tuple[int, int]:

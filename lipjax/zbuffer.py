@@ -29,10 +29,10 @@ def nearest_per_cell(cell: np.ndarray, cost: np.ndarray, tiebreak: np.ndarray | 
 
 
 def splat_nearest(pixel: np.ndarray, depth_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """An (H, W) float32 depth image (metres, 0 = empty) from depths at flat pixel indices (row * W + column);
-    where several land in one pixel the smallest depth is kept."""
+    """An (H, W) float32 depth image (metres, 0 = empty) from positive depths at flat pixel indices (row * W +
+    column); where several land in one pixel the smallest depth is kept (np.minimum.at: one pass, no sort)."""
     h, w = size
-    out = np.zeros(h * w, np.float32)
-    keep = nearest_per_cell(pixel, depth_m)
-    out[np.asarray(pixel)[keep]] = np.asarray(depth_m)[keep]
+    out = np.full(h * w, np.inf, np.float32)
+    np.minimum.at(out, np.asarray(pixel), np.asarray(depth_m, np.float32))
+    out[out == np.inf] = 0.0
     return out.reshape(h, w)
