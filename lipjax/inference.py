@@ -171,12 +171,13 @@ def reproject_sparse(sparse_m: np.ndarray, size: tuple[int, int]) -> np.ndarray:
     return splat_nearest(r * w + c, sparse.ravel()[flat], (h, w))
 
 
-def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> tuple[int, int]:
+def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None, *,
+               scan_lines: bool | None = None) -> tuple[int, int]:
     """(h, w) at which `completer` runs on a frame with (H, W) sparse depth `sparse_m` (metres, 0 = none).
 
     `max_side` (pixels, >= MIN_MAX_SIDE_PX) caps the longer side; without it a learned model runs at the
     working size of its samples' spacing and pattern (`lipjax.resolution.working_size`) and a classical fill at
-    full size.
+    full size. `scan_lines`: lipjax.inputs.is_lidar_pattern of `sparse_m`, asked here when not given.
     """
     shape = tuple(np.shape(sparse_m))
     if max_side is not None:
@@ -189,16 +190,18 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None) -> 
     spacing = sample_spacing_px(sparse_m)
     if spacing == float("inf"):
         return shape
-    return working_size(shape, spacing, capped=is_capped(int(np.count_nonzero(sparse_m > 0)), shape,
-                                                         is_lidar_pattern(sparse_m)))
+    lines = is_lidar_pattern(sparse_m) if scan_lines is None else scan_lines
+    return working_size(shape, spacing, capped=is_capped(int(np.count_nonzero(sparse_m > 0)), shape, lines))
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
                    mirror: bool | None = None, cross_check: bool = CROSS_CHECK) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`);
     `max_side` caps the longer side instead (pixels), `mirror` and `cross_check` as in `complete_at`."""
-    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side), mirror=mirror,
-                       cross_check=cross_check)
+    # asked once for both (about 1 ms on a KITTI scan); for a classical fill after complete_at's input checks
+    lines = is_lidar_pattern(sparse_m) if isinstance(completer, Completer) and max_side is None else None
+    return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side, scan_lines=lines),
+                       mirror=mirror, cross_check=cross_check, scan_lines=lines)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -241,7 +244,7 @@ def mirrors(completer, scan_lines: bool, mirror: bool | None) -> bool:
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
                 mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
-                spread: bool = SPREAD_RESIDUALS) -> np.ndarray:
+                spread: bool = SPREAD_RESIDUALS, scan_lines: bool | None = None) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w).
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
@@ -253,7 +256,8 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     With `mirror` a learned model's estimate is `mirror_averaged`; None (the default) does so on LiDAR scan lines
     (`mirrors`; MIRROR_SCAN_LINES says why). With `cross_check` (CROSS_CHECK) a learned model's estimate of
     scattered samples is checked against the linear fill on held-out samples and blended with it where it is the
-    worse (`lipjax.crosscheck.cross_checked`).
+    worse (`lipjax.crosscheck.cross_checked`). `scan_lines`: lipjax.inputs.is_lidar_pattern of `sparse_m`, asked
+    here when not given.
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
     bilinear(z): it was worse on every synthetic setting of benchmarks/working_resolution.py, 0.83 against 0.67 x
     linear on 352x1216 streets with 64 beams.)
@@ -269,7 +273,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
     h, w = size
     if mirror and not isinstance(completer, Completer):
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
-    lines = is_lidar_pattern(sparse_m)  # asked once here: the mirror image, the spread's sigmas, the check
+    lines = is_lidar_pattern(sparse_m) if scan_lines is None else scan_lines  # the mirror, the sigmas, the check
     run = functools.partial(mirror_averaged, completer) if mirrors(completer, lines, mirror) else completer
     scan_lines = spread and (h, w) != (big_h, big_w) and lines  # the spread's sigmas
 

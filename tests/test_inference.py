@@ -243,6 +243,12 @@ def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
         assert np.abs(run(lines) - run(lines, False)).max() > 1e-3
         np.testing.assert_array_equal(run(scattered), run(scattered, False))
         assert np.abs(run(scattered) - run(scattered, True)).max() > 1e-3
+    # a caller that already asked the pattern (complete_frame) is believed: at full size (nothing spread) scan_lines
+    # only decides the mirror image
+    np.testing.assert_array_equal(complete_at(completer, rgb, scattered, (40, 56), cross_check=False, scan_lines=True),
+                                  complete_at(completer, rgb, scattered, (40, 56), cross_check=False, mirror=True))
+    np.testing.assert_array_equal(complete_at(completer, rgb, lines, (40, 56), cross_check=False, scan_lines=False),
+                                  complete_at(completer, rgb, lines, (40, 56), cross_check=False, mirror=False))
     np.testing.assert_array_equal(lipjax.complete(rgb, lines, model=completer),
                                   lipjax.complete(rgb, lines, model=completer, mirror=True))
     assert not mirrors(methods.get_completer("linear"), True, None) and mirrors(completer, True, None)

@@ -102,6 +102,8 @@ def test_frame_size_follows_the_samples_for_learned_models_only():
                                                                             capped=True)
     scattered = _sparse(352, 1216, int(np.count_nonzero(lines)))
     assert not is_lidar_pattern(scattered) and inference.frame_size(model, scattered) == (352, 1216)
+    assert inference.frame_size(model, scattered, scan_lines=True) == (h, w)  # a caller's pattern is believed
+    assert inference.frame_size(model, lines, scan_lines=False) == (352, 1216)
     # a dense map (a depth camera's, over DENSE samples a pixel) is capped as scan lines are; just below, full size
     n_dense = int(DENSE * 240 * 320)
     assert inference.frame_size(model, _sparse(240, 320, n_dense)) == (240, 320)
