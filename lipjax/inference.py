@@ -275,7 +275,6 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
     lines = is_lidar_pattern(sparse_m) if scan_lines is None else scan_lines  # the mirror, the sigmas, the check
     run = functools.partial(mirror_averaged, completer) if mirrors(completer, lines, mirror) else completer
-    scan_lines = spread and (h, w) != (big_h, big_w) and lines  # the spread's sigmas
 
     def estimate(sparse: np.ndarray, at: tuple[int, int]) -> np.ndarray:  # z (H, W) from a sparse map, run at `at`
         if at == (big_h, big_w):
@@ -283,7 +282,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         small_rgb = cv2.resize(rgb, at[::-1], interpolation=cv2.INTER_AREA)
         small = np.asarray(run(small_rgb, reproject_sparse(sparse, at)), np.float32)
         z = cv2.resize(small, (big_w, big_h), interpolation=cv2.INTER_LINEAR)
-        return spread_on_host(z, sparse, at, scan_lines) if spread else z  # before any set-back
+        return spread_on_host(z, sparse, at, lines) if spread else z  # before any set-back; sigmas of the pattern
 
     if cross_check and isinstance(completer, Completer):
         dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w), scan_lines=lines)
