@@ -12,9 +12,9 @@ WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
 
 # The default shipped model per scene: one model, lip-any, for rooms and streets and every sensor. The rule, fixed
 # before the real frames were scored: lip-any is the default for every input if it is within 10 % of the per-scene
-# models on the synthetic tables (Table I 0.1561 m against lip-ad-fast-indoor's 0.1762, bound 0.1938; Table II
-# 3035 mm against lip-ad-fast-outdoor's 3661, bound 4027: `python -m experiments.nyu_200pts`, `python -m
-# experiments.kitti_dc`, at 1,476,640 images; 0.1894 m and 4016 mm when it was first chosen, at 164,000). The
+# models on the synthetic tables (Table I 0.1544 m against lip-ad-fast-indoor's 0.1762, bound 0.1938; Table II
+# 3042 mm against lip-ad-fast-outdoor's 3661, bound 4027: `python -m experiments.nyu_200pts`, `python -m
+# experiments.kitti_dc`, at 1,572,640 images; 0.1894 m and 4016 mm when it was first chosen, at 164,000). The
 # per-scene models stay, for the paper's tables and by name.
 DEFAULT_MODELS = {"indoor": "lip-any", "outdoor": "lip-any"}
 DEFAULT_MODEL = DEFAULT_MODELS["indoor"]
