@@ -199,7 +199,7 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     """Dense (H, W) float32 metres for one frame, the model run at its working size (`frame_size`, `complete_at`);
     `max_side` caps the longer side instead (pixels), `mirror` and `cross_check` as in `complete_at`."""
     # asked once for both (about 1 ms on a KITTI scan); for a classical fill after complete_at's input checks
-    lines = is_lidar_pattern(sparse_m) if isinstance(completer, Completer) and max_side is None else None
+    lines = is_lidar_pattern(sparse_m) if isinstance(completer, Completer) else None
     return complete_at(completer, rgb, sparse_m, frame_size(completer, sparse_m, max_side, scan_lines=lines),
                        mirror=mirror, cross_check=cross_check, scan_lines=lines)
 
