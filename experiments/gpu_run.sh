@@ -1,25 +1,35 @@
 #!/bin/bash
-# One run of lip-any's chain in a fixed time on a GPU host with many cores (a lent 16-core H200), from the repository
-# root (docs/training.md, runs 45 and 47):
+# The equal-budget study (python -m experiments.equal_budget) on a GPU host with many cores, in one call of a fixed
+# time, from the repository root:
 #
-#   INIT=experiments/warm_starts/lip-any-next SEED=45 OUT=/tmp/out [WHEELS=DIR] [BUDGET_S=585] [STEPS=N] \
+#   OUT=/tmp/out [BUDGET_S=560] [WORKERS=14] [IMAGES=30000] [STUDY_ARGS="--scene indoor --seeds 1,2"] [WHEELS=DIR] \
 #       bash experiments/gpu_run.sh
 #
-# The lip_any recipe of the CPU runs (clutter, porous trees, log RMSE) from INIT with its own SEED, 14 loader
-# workers. Without STEPS a PROBE_S-second probe of the same command measures images/s and g_steps is set to what
-# fills BUDGET_S (a multiple of 120); validation and checkpoints come every g_steps / 12, so that the mean of the last
-# 4 spans the run's last third, as in the 3,000-step runs. Writes OUT/log.txt, OUT/metrics.jsonl and the exports
-# OUT/lip-any<SEED>-last and -avg4 (or, if exporting fails, the workdir as OUT/ckpt.tgz.* in 15 MB parts).
-# WHEELS: a folder of wheels installed first (no index, no dependencies), for a host without grain and the like.
+# Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops) in
+# runs/study, which it continues where a carried runs/study/<scene>/tuning.json and results/ (device `carry`) say it
+# stands, then packs what it finished into OUT: log.txt, scores.tgz (tuning, scores, the report) and the exported
+# models at the budget IMAGES, models.tgz.* (15 MB parts). Back on the CPU machine:
+#
+#   tar xzf scores.tgz -C runs/study && cat models.tgz.* | tar xzf - -C runs/study
+#
+# and the CPU study (python -m experiments.equal_budget) skips what the GPU finished. TINY=1: the tiny check
+# (tiny networks, 48x64 frames, a few images) in its own root, runs/study-tiny, to test the script on a CPU.
 set -u
 T0=$(date +%s)
-: "${INIT:?INIT=model to start from}" "${SEED:?SEED=a seed no run of the chain has had}" "${OUT:?OUT=output folder}"
-BUDGET_S=${BUDGET_S:-585}
-PROBE_S=${PROBE_S:-100}
+: "${OUT:?OUT=output folder}"
+BUDGET_S=${BUDGET_S:-560}
 RESERVE_S=${RESERVE_S:-60}
+WORKERS=${WORKERS:-14}
+IMAGES=${IMAGES:-30000}
+ROOT=runs/study
+ARGS="${STUDY_ARGS:-}"
+if [ -n "${TINY:-}" ]; then
+  ROOT=runs/study-tiny
+  IMAGES=96
+  ARGS="--tiny --curve 48,96 --tune-images 32 --adv-images 40 --limit 2 --methods ma2018,lip-cnn,lip-ad $ARGS"
+fi
 LOG=$OUT/log.txt
-mkdir -p "$OUT"
-elapsed() { echo $(( $(date +%s) - T0 )); }
+mkdir -p "$OUT" "$ROOT"
 if [ -n "${WHEELS:-}" ]; then
   python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site \
     "$WHEELS"/*.whl >> "$LOG" 2>&1 || { echo "installing $WHEELS failed" >> "$LOG"; exit 3; }
@@ -28,30 +38,14 @@ fi
 export PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false JAX_COMPILATION_CACHE_DIR=/tmp/jaxcache
 python3 -c "import jax, flax, grain; print('jax', jax.__version__, 'flax', flax.__version__, jax.devices())" \
   >> "$LOG" 2>&1 || { echo "import failed" >> "$LOG"; exit 4; }
-TRAIN="python3 -m experiments.train --config lip_any --no-progress --set init_from=$INIT --set seed=$SEED
-  --set data.clutter_prob=0.5 --set data.foliage_prob=0.5 --set loss=log_rmse --set data.num_workers=14"
-if [ -z "${STEPS:-}" ]; then
-  timeout -s TERM "$PROBE_S" $TRAIN --workdir /tmp/probe --set g_steps=100000 --set eval_every=100000 \
-    --set checkpoint_every=100000 >> "$LOG" 2>&1
-  RATE=$(python3 -c "import json, statistics; rows = open('/tmp/probe/metrics.jsonl').read().splitlines()
-r = [json.loads(l)['images_per_s'] for l in rows if 'images_per_s' in l][-6:]; print(statistics.median(r or [0]))")
-  LEFT=$(( BUDGET_S - $(elapsed) - RESERVE_S ))
-  STEPS=$(python3 -c "print(max(120, int($RATE * max($LEFT - 60, 0) / 8 / 120) * 120))")
-  echo "== probe: $RATE images/s" >> "$LOG"
-fi
-EVERY=$(( STEPS / 12 ))
-LEFT=$(( BUDGET_S - $(elapsed) - RESERVE_S ))
-echo "== g_steps $STEPS, validation and checkpoints every $EVERY, $LEFT s left at $(elapsed) s" >> "$LOG"
-W=/tmp/run$SEED
-RUN="--workdir $W --set g_steps=$STEPS --set eval_every=$EVERY --set checkpoint_every=$EVERY --set keep_checkpoints=6"
-timeout -s TERM "$LEFT" $TRAIN $RUN >> "$LOG" 2>&1
-echo "== training ended ($?) at $(elapsed) s" >> "$LOG"
-cp $W/metrics.jsonl "$OUT"/ 2>/dev/null
-$TRAIN $RUN --export-only --export "$OUT/lip-any$SEED-last" >> "$LOG" 2>&1 &
-$TRAIN $RUN --export-only --average 4 --export "$OUT/lip-any$SEED-avg4" >> "$LOG" 2>&1
-wait
-if [ ! -f "$OUT/lip-any$SEED-avg4.msgpack" ]; then
-  echo "== exporting failed: the workdir is in ckpt.tgz.*" >> "$LOG"
-  tar cf - -C $W . | gzip -1 | split -b 15M - "$OUT/ckpt.tgz."
-fi
-echo "== done at $(elapsed) s" >> "$LOG"
+LEFT=$(( BUDGET_S - ($(date +%s) - T0) - RESERVE_S ))
+echo "== the study for $LEFT s: $ARGS" >> "$LOG"
+timeout -s TERM "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --results "$ROOT/report" --workers \
+  "$WORKERS" --images "$IMAGES" --no-progress $ARGS >> "$LOG" 2>&1
+echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
+python3 -m experiments.equal_budget --root "$ROOT" --results "$ROOT/report" --report --images "$IMAGES" $ARGS >> "$LOG" 2>&1
+(cd "$ROOT" && tar czf "$OUT/scores.tgz" --exclude='*/checkpoints' --exclude='*.msgpack' --exclude='*/models/*.json' \
+  $(ls -d */tuning.json */results report 2>/dev/null))
+(cd "$ROOT" && ls -d */*/seed*/models/"$IMAGES".* */*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
+  | split -b 15M - "$OUT/models.tgz.")
+echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

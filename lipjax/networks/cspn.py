@@ -10,7 +10,7 @@ import jax
 import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, network_input
+from lipjax.networks.common import NetworkModel, check_depth_scale, check_max_depth, depth_unit, network_input
 from lipjax.networks.unet import UNetBody
 
 
@@ -102,16 +102,19 @@ class CSPN(NetworkModel):
     Attributes:
       base_width, levels: the backbone (as in `UNet`).
       iterations: T propagation steps (the paper: 24).
-      max_depth_m: depth normalisation (metres).
+      max_depth_m: the depth range (metres), the depth unit under depth_scale "max_depth".
+      depth_scale: the depth unit of the network's input and output (lipjax.networks.common.DEPTH_SCALES).
     """
 
     base_width: int = 64
     levels: int = 4
     iterations: int = 12
     max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
+    depth_scale: str = "max_depth"  # lipjax.networks.common.DEPTH_SCALES
 
     def __post_init__(self):
         check_max_depth(self.max_depth_m)
+        check_depth_scale(self.depth_scale)
         if self.base_width < 1 or self.levels < 1 or self.iterations < 0:
             raise ValueError(f"need base_width, levels >= 1 and iterations >= 0, got "
                              f"{self.base_width}, {self.levels}, {self.iterations}")
@@ -130,10 +133,11 @@ class CSPN(NetworkModel):
         _, h, w = sparse.shape
         sparse = sparse.astype(jnp.float32)
         mask = (sparse > 0) if weights is None else (weights > 0)
-        x = network_input(rgb, sparse, self.max_depth_m, self.multiple)
+        unit = depth_unit(sparse, self.depth_scale, self.max_depth_m)
+        x = network_input(rgb, sparse, unit, self.multiple)
         d0, affinity = self.module().apply({"params": params}, x)
-        d = propagate(d0[:, :h, :w], affinity[:, :h, :w], sparse / self.max_depth_m, mask, self.iterations)
-        # The last replacement in metres: (s / max_depth) * max_depth need not round back to s exactly.
-        return jnp.where(mask, sparse, d * self.max_depth_m), None
+        d = propagate(d0[:, :h, :w], affinity[:, :h, :w], sparse / unit, mask, self.iterations)
+        # The last replacement in metres: (s / u) * u need not round back to s exactly.
+        return jnp.where(mask, sparse, d * unit), None
 
 

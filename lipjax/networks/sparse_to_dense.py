@@ -7,7 +7,7 @@ import flax.linen as nn
 import jax
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, group_norm
+from lipjax.networks.common import NetworkModel, check_depth_scale, check_max_depth, group_norm
 from lipjax.priors.network import UpProjection
 
 
@@ -74,17 +74,20 @@ class SparseToDense(NetworkModel):
       width_multiplier: w = round(64 * width_multiplier) (ResNet's 64); 1.0 is the published width.
       blocks: basic blocks per stage; (2, 2, 2, 2) is ResNet-18, (3, 4, 6, 3) ResNet-34. (Ma et al. also use the
         bottleneck ResNet-50, not implemented here.)
-      max_depth_m: depth normalisation (metres).
+      max_depth_m: the depth range (metres), the depth unit under depth_scale "max_depth".
+      depth_scale: the depth unit of the network's input and output (lipjax.networks.common.DEPTH_SCALES).
     """
 
     width_multiplier: float = 1.0
     blocks: tuple[int, ...] = (2, 2, 2, 2)
     max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
+    depth_scale: str = "max_depth"  # lipjax.networks.common.DEPTH_SCALES
 
     multiple = 32  # the encoder's total downsampling (class attribute, not a field)
 
     def __post_init__(self):
         check_max_depth(self.max_depth_m)
+        check_depth_scale(self.depth_scale)
         if len(self.blocks) != 4 or min(self.blocks) < 1:
             raise ValueError(f"blocks must be 4 positive block counts (ResNet stages), got {self.blocks}")
         w = self.width

@@ -7,7 +7,7 @@ import flax.linen as nn
 import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
-from lipjax.networks.common import NetworkModel, check_max_depth, group_norm
+from lipjax.networks.common import NetworkModel, check_depth_scale, check_max_depth, group_norm
 from lipjax.priors.guided import depth_to_space
 
 
@@ -71,15 +71,18 @@ class UNet(NetworkModel):
     Attributes:
       base_width: channels of the first level (Ronneberger et al.: 64); level l has base_width * 2**l.
       levels: number of 2x poolings (4 in the paper); inputs are padded to a multiple of 2**levels.
-      max_depth_m: depth normalisation (metres).
+      max_depth_m: the depth range (metres), the depth unit under depth_scale "max_depth".
+      depth_scale: the depth unit of the network's input and output (lipjax.networks.common.DEPTH_SCALES).
     """
 
     base_width: int = 64
     levels: int = 4
     max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
+    depth_scale: str = "max_depth"  # lipjax.networks.common.DEPTH_SCALES
 
     def __post_init__(self):
         check_max_depth(self.max_depth_m)
+        check_depth_scale(self.depth_scale)
         if self.base_width < 1 or self.levels < 1:
             raise ValueError(f"base_width and levels must be >= 1, got {self.base_width}, {self.levels}")
 

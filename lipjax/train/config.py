@@ -68,6 +68,10 @@ class DataConfig:
 
 
 LOSS_SCALES = ("max_depth", "samples")
+# The learning rate of G over a run (lipjax.train.state.g_learning_rate): "cosine" warms up, then decays to 5 % of
+# learning_rate at the run's last step; "constant" warms up, then holds learning_rate, so that the model at step s
+# does not depend on how long the run is (the equal-budget study: one run gives every budget of its curve).
+LR_SCHEDULES = ("cosine", "constant")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,6 +89,7 @@ class TrainConfig:
     learning_rate: float = 1e-3
     d_learning_rate: float = 2e-4
     warmup_steps: int = 100
+    schedule: str = "cosine"  # LR_SCHEDULES
     weight_decay: float = 1e-4
     grad_clip_norm: float = 1.0
     loss: str = "l2"  # lipjax.train.losses.LOSS_KINDS; experiments/configs/ set "l1", lip_any "log_rmse"
@@ -108,6 +113,8 @@ class TrainConfig:
             raise ValueError(f"loss_scale must be one of {LOSS_SCALES}, got {self.loss_scale!r}")
         if self.loss not in LOSS_KINDS:
             raise ValueError(f"loss must be one of {LOSS_KINDS}, got {self.loss!r}")
+        if self.schedule not in LR_SCHEDULES:
+            raise ValueError(f"schedule must be one of {LR_SCHEDULES}, got {self.schedule!r}")
 
     @property
     def total_steps(self) -> int:

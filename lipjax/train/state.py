@@ -24,14 +24,20 @@ class TrainState:
     rng: jax.Array
 
 
+def g_learning_rate(config: TrainConfig) -> optax.Schedule:
+    """G's learning rate by step: a linear warm-up from 0 over `warmup_steps` (at most the run's steps - 1), then
+    `config.schedule`: "cosine" decays to 5 % of learning_rate at the run's last step, "constant" holds it."""
+    warmup = max(1, min(config.warmup_steps, config.total_steps - 1))
+    if config.schedule == "constant":
+        return optax.linear_schedule(0.0, config.learning_rate, warmup)
+    return optax.warmup_cosine_decay_schedule(0.0, config.learning_rate, warmup, max(2, config.total_steps),
+                                              end_value=0.05 * config.learning_rate)
+
+
 def make_optimizers(config: TrainConfig) -> tuple[optax.GradientTransformation, optax.GradientTransformation]:
-    """AdamW with warm-up and cosine decay over the run, after global-norm clipping, for G; Adam for D."""
-    g_schedule = optax.warmup_cosine_decay_schedule(
-        0.0, config.learning_rate, max(1, min(config.warmup_steps, config.total_steps - 1)),
-        max(2, config.total_steps), end_value=0.05 * config.learning_rate,
-    )
+    """AdamW with `g_learning_rate`, after global-norm clipping, for G; Adam for D."""
     g_opt = optax.chain(optax.clip_by_global_norm(config.grad_clip_norm),
-                        optax.adamw(g_schedule, weight_decay=config.weight_decay))
+                        optax.adamw(g_learning_rate(config), weight_decay=config.weight_decay))
     d_opt = optax.chain(optax.clip_by_global_norm(config.grad_clip_norm), optax.adam(config.d_learning_rate, b1=0.5))
     return g_opt, d_opt
 

@@ -1,0 +1,104 @@
+"""The equal-budget study's methods (experiments/equal_budget.py): every learned method of Tables I and II as one
+trunk config on one scene's data, or as an adversarial branch of a trunk.
+
+A trunk trains from random weights with a constant learning rate after its warm-up (TrainConfig.schedule
+"constant"), so that its checkpoint at N images is the same model whatever the run's length: one run per seed gives
+every budget of the data-efficiency curve. Every trunk of a scene reads the same frames, crops and samples: the
+scene base's data (experiments/configs/base.py) with the study's seed.
+
+A branch is LIP+AD (paper Sec. III-B): from its trunk's model at N - adv_images images, D is pretrained with G
+frozen (BRANCH_D_STEPS steps), then G and D train together for the rest, so that it too has read N images.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+from experiments.configs.base import INDOOR, OUTDOOR, fast_model
+from experiments.configs.paper import BASELINE_PRESET, baseline
+from lipjax.data.synthetic.dataset import SyntheticDataset
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
+from lipjax.model import LIPConfig
+from lipjax.networks import baseline_preset
+from lipjax.priors.network import network_preset
+from lipjax.train.config import DataConfig, TrainConfig
+from lipjax.train.discriminator import Discriminator
+
+SCENES = ("indoor", "outdoor")
+BASES = {"indoor": INDOOR, "outdoor": OUTDOOR}
+END_TO_END = ("ma2018", "unet", "cspn")  # the end-to-end networks (lipjax.networks)
+TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
+# branch -> (its trunk, what D sees): the paper's D on depth for the paper's prox; on log-depth gradients for the
+# fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
+BRANCHES = {"lip-ad": ("lip-cnn", "depth"), "lip-ad-fast": ("lip-fast", "log_gradients")}
+METHODS = TRUNKS + tuple(BRANCHES)
+# D pretraining steps of a branch (at most a fifth of them); the paper's LIP+AD configs use 50 D steps and 200
+# joint steps (2,000 images).
+BRANCH_D_STEPS = 50
+# A branch reads fresh frames: its data stream is seed + BRANCH_SEED_OFFSET (the trunk's own seed would read the
+# trunk's first batches again: a batch is a function of the seed and the step).
+BRANCH_SEED_OFFSET = 1000
+WARMUP_STEPS = 100
+# The end-to-end networks see depth in units of each frame's own sample scale (lipjax.networks.common.DEPTH_SCALES):
+# in units of the 10 m depth range, Ma et al. at 3,000 images scored a validation RMSE of 1.22 m and ignored the
+# samples' level (its per-frame medians barely followed the truth's; GroupNorm erases a frame's absolute level); in
+# units of the samples, 0.53 m at the same budget and learning rate (docs/decisions/0027-end-to-end-depth-unit.md).
+END_TO_END_DEPTH_SCALE = "samples"
+# The tiny variant (tests; a check of the GPU script): tiny networks on 48x64 renders, 32x48 crops.
+TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
+
+
+def _tiny(config: TrainConfig) -> TrainConfig:
+    h, w = TINY_SIZE
+    return dataclasses.replace(config, data=dataclasses.replace(config.data, height=h, width=w, crop=TINY_CROP,
+                                                                val_images=4))
+
+
+def trunk_config(method: str, scene: str, *, learning_rate: float, seed: int, steps: int,
+                 tiny: bool = False) -> TrainConfig:
+    """The run of trunk `method` on `scene` for `steps` steps (batch 8): the scene base with that model, the
+    constant schedule, checkpoints every 250 steps (2,000 images), validation every 1,250 (10,000 images)."""
+    if method not in TRUNKS:
+        raise ValueError(f"unknown trunk {method!r}; choose one of {TRUNKS}")
+    base, max_depth = BASES[scene], SCENE_MAX_DEPTH_M[scene]
+    if method in END_TO_END:
+        model_type = {"ma2018": "sparse_to_dense", "unet": "unet", "cspn": "cspn"}[method]
+        config = baseline(base, method, model_type)
+        model = baseline_preset(model_type, "tiny" if tiny else BASELINE_PRESET, max_depth_m=max_depth)
+        config = dataclasses.replace(config, model=dataclasses.replace(model, depth_scale=END_TO_END_DEPTH_SCALE))
+    elif method == "lip-cnn":
+        config = base if not tiny else dataclasses.replace(
+            base, model=dataclasses.replace(base.model, prior=dataclasses.replace(
+                network_preset("tiny", max_depth_m=max_depth), depth_domain=base.model.prior.depth_domain)))
+    else:
+        model = fast_model(max_depth, base.model.initial_estimate)
+        config = dataclasses.replace(base, model=model if not tiny else LIPConfig(
+            prior=network_preset("tiny", max_depth_m=max_depth), num_iterations=2,
+            initial_estimate=base.model.initial_estimate))
+    config = dataclasses.replace(
+        config, name=f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate, schedule="constant",
+        g_steps=steps, d_steps=0, adv_steps=0, warmup_steps=WARMUP_STEPS, init_from=None, checkpoint_every=250,
+        eval_every=1250, keep_checkpoints=2, log_every=50)
+    return _tiny(config) if tiny else config
+
+
+def branch_config(method: str, trunk: TrainConfig, init_from: str, adv_images: int) -> TrainConfig:
+    """LIP+AD `method` from the trunk's model at `init_from`: BRANCH_D_STEPS steps of D, then the joint steps, in all
+    adv_images images (batch 8) at the trunk's learning rate."""
+    _, inputs = BRANCHES[method]
+    steps = adv_images // trunk.batch_size
+    d_steps = min(BRANCH_D_STEPS, steps // 5)  # a fifth at most: the tiny check's few steps
+    if d_steps < 1:
+        raise ValueError(f"adv_images {adv_images} gives {steps} steps; LIP+AD needs at least 5 (a fifth of them D "
+                         "pretraining, the rest joint steps)")
+    name = trunk.name.replace(BRANCHES[method][0], method, 1)
+    return dataclasses.replace(
+        trunk, name=name, init_from=init_from, seed=trunk.seed + BRANCH_SEED_OFFSET, g_steps=0, d_steps=d_steps,
+        adv_steps=steps - d_steps, warmup_steps=20, adv_weight=1e-3, eval_every=steps, checkpoint_every=50,
+        discriminator=Discriminator(max_depth_m=trunk.model.max_depth_m, inputs=inputs))
+
+
+def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:
+    """The synthetic test split of Table I (rooms, 256x320) or Table II (streets, 128x416)."""
+    data: DataConfig = BASES[scene].data
+    h, w = TINY_SIZE if tiny else (data.height, data.width)
+    return SyntheticDataset(scene, "test", height=h, width=w)

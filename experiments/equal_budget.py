@@ -1,0 +1,326 @@
+"""The paper's comparison at equal training budgets: every learned method of Table I (rooms, 200 points) and Table II
+(streets, 64-beam LiDAR) trained on the same data for the same number of images, with several seeds, and scored on
+the tables' synthetic test splits (issue 52).
+
+    python -m experiments.equal_budget                 # the whole study; resumes where it stopped
+    python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 10000,30000
+    python -m experiments.equal_budget --plan          # what is done and what is left, without running anything
+    python -m experiments.equal_budget --report        # docs/results/equal_budget.json, tables, figures, tests
+    python -m experiments.equal_budget --tiny --root /tmp/study --images 96 --curve 48,96 --tune-images 32 \\
+        --adv-images 32 --limit 2                        # a check in a minute: tiny networks on 48x64 frames
+
+Methods (experiments/configs/study.py): Ma et al. (ma2018), U-Net, CSPN, LIP+CNN with the paper's prox (lip-cnn),
+LIP with the fast prox (lip-fast), and LIP+AD of each (lip-ad, lip-ad-fast: the last adv_images of the budget
+adversarial). LIP+Wavelet needs no training and is not part of the study. Every run reads the scene's training data
+with the study's seed, batch 8, a constant learning rate after 100 warm-up steps; "images" counts G's training
+images (batch x steps, a branch's D steps included), equal for every method.
+
+Stages, each skipped when its output exists, so the study continues across sessions and survives any stop (every
+run is a checkpointed training that resumes):
+  1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS
+     (seed 0, the validation split: never the test split); the same small budget for every trunk;
+  2. per scene, per seed: each trunk to each budget of its curve (--curve points <= --images for every seed, all of
+     --curve for seed 0), its model exported and scored on the test split at each; each branch at each budget;
+  3. the report (also --report): docs/results/equal_budget.json, docs/results/equal_budget.md, the data-efficiency
+     curve and Fig. 4a (RMSE against the ADMM iteration count K over the seeds) as PNGs, and paired tests.
+Order: the tuning and every seed at --images on rooms, then streets, then seed 0 beyond --images (the curve).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import pathlib
+import sys
+
+import numpy as np
+
+from experiments.configs.study import BRANCHES, METHODS, SCENES, TRUNKS, branch_config, test_split, trunk_config
+from lipjax.train.config import TrainConfig
+from lipjax.console import ArgumentParser, run_main
+from lipjax.data.protocols import get_protocol
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.utils import enable_compilation_cache, written_whole
+
+PROG = f"python -m {__spec__.name}"
+
+TUNE_LRS = (2e-4, 5e-4, 1.25e-3)  # x2.5 steps around the configs' 5e-4; the same three for every trunk
+TEST_INPUT = {"indoor": "uniform:200", "outdoor": "lidar:hdl64"}  # Tables I and II
+TEST_LIMIT = {"indoor": 100, "outdoor": 50}  # the tables' default frame counts
+DEFAULT_SEEDS = {"indoor": (0, 1, 2), "outdoor": (0,)}
+DEFAULT_CURVE = {"indoor": (10_000, 30_000, 100_000), "outdoor": ()}
+BATCH = 8
+
+
+@dataclasses.dataclass(frozen=True)
+class Study:
+    """What to run. images: the budget B of every run of the tables; curve: the budgets scored on the way (seed 0
+    goes on to the largest); adv_images: the adversarial part of a LIP+AD budget; limit: test frames (None: the
+    tables' own counts); tiny: tiny networks and frames (checks, not results)."""
+
+    root: pathlib.Path
+    scenes: tuple[str, ...] = SCENES
+    seeds: dict = dataclasses.field(default_factory=lambda: dict(DEFAULT_SEEDS))
+    images: int = 30_000
+    curve: dict = dataclasses.field(default_factory=lambda: dict(DEFAULT_CURVE))
+    tune_images: int = 3_000
+    adv_images: int = 2_000
+    limit: int | None = None
+    tiny: bool = False
+    methods: tuple[str, ...] = METHODS
+    workers: int = 1  # loader processes of every run (data.num_workers: how fast, not what it reads)
+
+    def __post_init__(self):
+        for n in (self.images, self.tune_images, self.adv_images, *[c for cs in self.curve.values() for c in cs]):
+            if n % BATCH or n <= 0:
+                raise ValueError(f"image counts must be positive multiples of the batch size {BATCH}, got {n}")
+        if self.adv_images >= min(self.budgets_for(s, 0)[0] for s in self.scenes):
+            raise ValueError(f"--adv-images {self.adv_images} must be below the smallest budget")
+
+    def budgets_for(self, scene: str, seed: int) -> list[int]:
+        """The budgets a run of `seed` is scored at: the curve's up to `images`, and `images`; seed 0 all of the
+        curve."""
+        curve = self.curve.get(scene, ())
+        return sorted({self.images, *(c for c in curve if c <= self.images or seed == 0)})
+
+    def scene_dir(self, scene: str) -> pathlib.Path:
+        return self.root / scene
+
+
+# ---- stage 1: tuning -------------------------------------------------------------------------------------------
+
+def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) -> float:
+    """The trunk's learning rate: the lowest validation RMSE after tune_images images of seed 0 among TUNE_LRS
+    (cached in <scene>/tuning.json with every rate's score)."""
+    from lipjax.train.loop import evaluate_params, train, validation_batches
+
+    path = study.scene_dir(scene) / "tuning.json"
+    table = json.loads(path.read_text()) if path.exists() else {}
+    scores = table.get(trunk, {})
+    for lr in TUNE_LRS:
+        if f"{lr:g}" in scores:
+            continue
+        config = trunk_config(trunk, scene, learning_rate=lr, seed=0, steps=study.tune_images // BATCH,
+                              tiny=study.tiny)
+        config = with_workers(dataclasses.replace(config, eval_every=config.g_steps), study.workers)
+        state = train(config, study.scene_dir(scene) / "tune" / trunk / f"lr{lr:g}", progress=progress)
+        val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
+        scores[f"{lr:g}"] = {"val_rmse_m": val["rmse_m"], "val_mae_m": val["mae_m"], "images": study.tune_images}
+        table[trunk] = scores
+        _write_json(path, table)
+        print(f"[study] {scene} {trunk} lr {lr:g}: val rmse_m={val['rmse_m']:.4f}", flush=True)
+    return float(min(scores, key=lambda k: scores[k]["val_rmse_m"]))
+
+
+def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
+    return dataclasses.replace(config, data=dataclasses.replace(config.data, num_workers=workers))
+
+
+# ---- stage 2: runs and scores ----------------------------------------------------------------------------------
+
+def result_path(study: Study, scene: str, method: str, seed: int, images: int) -> pathlib.Path:
+    return study.scene_dir(scene) / "results" / f"{method}-seed{seed}-{images}.json"
+
+
+def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:
+    """Trains trunk `trunk` of `seed` on to `upto` images, exporting its model at every budget on the way and at
+    every branch's starting point (budget - adv_images), and scores each budget on the test split."""
+    from lipjax.train.loop import export, train
+
+    lr = tuned_learning_rate(study, scene, trunk, progress)
+    budgets = [b for b in study.budgets_for(scene, seed) if b <= upto]
+    wanted_branches = [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    stops = sorted({*budgets, *(b - study.adv_images for b in budgets if wanted_branches)})
+    final = max(study.budgets_for(scene, seed))  # the run's length is fixed by its seed's largest budget
+    config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
+                                       tiny=study.tiny), study.workers)
+    workdir = study.scene_dir(scene) / trunk / f"seed{seed}"
+    for images in stops:
+        if not _needed(study, scene, trunk, seed, images, budgets, wanted_branches):
+            continue
+        model = workdir / "models" / str(images)
+        if not model.with_suffix(".msgpack").exists():
+            state = train(config, workdir, stop_at=images // BATCH, progress=progress)
+            if int(state.step) != images // BATCH:
+                raise ValueError(f"{workdir} is at {int(state.step) * BATCH} images, past {images}: a budget "
+                                 "added after the run went by it cannot be scored; start another --root")
+            export(config, state, model, {"learning_rate": lr, "schedule": config.schedule, "data": scene})
+        if images in budgets and not result_path(study, scene, trunk, seed, images).exists():
+            score(study, scene, trunk, seed, images, model)
+    for method in wanted_branches:
+        for images in budgets:
+            run_branch(study, scene, method, config, seed, images, progress)
+
+
+def _needed(study: Study, scene: str, trunk: str, seed: int, images: int, budgets: list[int],
+            branches: list[str]) -> bool:
+    """Whether the trunk's model at `images` is still wanted: a budget not scored yet, or the start of a branch
+    whose budget is not scored yet."""
+    if images in budgets and not result_path(study, scene, trunk, seed, images).exists():
+        return True
+    return any(images + study.adv_images in budgets and not result_path(study, scene, m, seed,
+                                                                         images + study.adv_images).exists()
+               for m in branches)
+
+
+def run_branch(study: Study, scene: str, method: str, trunk: TrainConfig, seed: int, images: int,
+               progress: bool) -> None:
+    """LIP+AD `method` at `images`: from its trunk's model at images - adv_images (experiments/configs/study.py)."""
+    from lipjax.train.run import run
+
+    if result_path(study, scene, method, seed, images).exists():
+        return
+    start = study.scene_dir(scene) / BRANCHES[method][0] / f"seed{seed}" / "models" / str(images - study.adv_images)
+    config = branch_config(method, trunk, str(start), study.adv_images)
+    workdir = study.scene_dir(scene) / method / f"seed{seed}" / str(images)
+    model = workdir / "model"
+    if not model.with_suffix(".msgpack").exists():
+        run(config, workdir, export=model, progress=progress)
+    score(study, scene, method, seed, images, model)
+
+
+def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path) -> dict:
+    """Scores `model` on the scene's test split (Table I / II input, protocol and frames), per frame, and for a LIP
+    model at every iteration count K (Fig. 4a); writes results/<method>-seed<seed>-<images>.json."""
+    from lipjax.evaluate import evaluate
+    from lipjax.inference import load_model
+    from lipjax.model import LIPConfig
+
+    completer = load_model(model)
+    dataset, sampler, protocol, limit = test_setup(study, scene)
+    per_k = {}
+    ks = range(1, completer.config.num_iterations + 1) if isinstance(completer.config, LIPConfig) else ()
+    for k in ks:
+        r = evaluate(completer.with_iterations(k), dataset, sampler, min_depth_m=protocol.min_depth_m,
+                     max_depth_m=protocol.max_depth_m, limit=limit, progress=False)
+        per_k[k] = r
+    full = per_k[max(ks)] if ks else evaluate(completer, dataset, sampler, min_depth_m=protocol.min_depth_m,
+                                              max_depth_m=protocol.max_depth_m, limit=limit, progress=False)
+    doc = {"method": method, "scene": scene, "seed": seed, "images": images,
+           "images_seen": completer.metadata.get("images_seen"), "model": str(model),
+           "rmse_m": full.metrics["rmse_m"], "mae_m": full.metrics["mae_m"], "metrics": full.metrics,
+           "per_image": [{"id": p["id"], "rmse_m": p["rmse_m"], "mae_m": p["mae_m"]} for p in full.per_image],
+           "rmse_m_by_iterations": {str(k): r.metrics["rmse_m"] for k, r in per_k.items()}}
+    if doc["images_seen"] != images:
+        raise RuntimeError(f"{model} has read {doc['images_seen']} images, the study asked {images}")
+    _write_json(result_path(study, scene, method, seed, images), doc)
+    print(f"[study] {scene} {method} seed {seed} at {images} images: test rmse_m={doc['rmse_m']:.4f} "
+          f"mae_m={doc['mae_m']:.4f}", flush=True)
+    return doc
+
+
+def test_setup(study: Study, scene: str):
+    """(dataset, sampler, protocol, frame limit) of the scene's table."""
+    protocol = get_protocol(f"synthetic_{scene}")
+    return (test_split(scene, study.tiny), sampler_from_spec(TEST_INPUT[scene]), protocol,
+            study.limit or TEST_LIMIT[scene])
+
+
+def score_classical(study: Study, scene: str) -> dict:
+    """The linear and nearest fills on the same test frames (<scene>/results/classical.json)."""
+    from lipjax.evaluate import evaluate
+    from lipjax.methods import get_completer
+
+    path = study.scene_dir(scene) / "results" / "classical.json"
+    if path.exists():
+        return json.loads(path.read_text())
+    dataset, sampler, protocol, limit = test_setup(study, scene)
+    doc = {}
+    for name in ("linear", "nearest"):
+        r = evaluate(get_completer(name), dataset, sampler, min_depth_m=protocol.min_depth_m,
+                     max_depth_m=protocol.max_depth_m, limit=limit, progress=False)
+        doc[name] = {"rmse_m": r.metrics["rmse_m"], "mae_m": r.metrics["mae_m"],
+                     "per_image": [{"id": p["id"], "rmse_m": p["rmse_m"], "mae_m": p["mae_m"]} for p in r.per_image]}
+    _write_json(path, doc)
+    return doc
+
+
+# ---- the plan ----------------------------------------------------------------------------------------------------
+
+def plan(study: Study) -> list[tuple[str, str, int, int]]:
+    """(scene, trunk, seed, up to images) in the order they run: every seed at `images` on each scene in turn, then
+    seed 0 on along the curve."""
+    trunks = [t for t in TRUNKS if t in study.methods or any(
+        BRANCHES[m][0] == t for m in study.methods if m in BRANCHES)]
+    steps = [(scene, t, seed, study.images) for scene in study.scenes for seed in study.seeds[scene] for t in trunks]
+    steps += [(scene, t, seed, max(study.budgets_for(scene, seed))) for scene in study.scenes
+              for seed in study.seeds[scene] for t in trunks if max(study.budgets_for(scene, seed)) > study.images]
+    return steps
+
+
+def missing(study: Study) -> list[str]:
+    """The scores the study still lacks, as 'scene method seed images'."""
+    left = []
+    for scene in study.scenes:
+        for seed in study.seeds[scene]:
+            for method in study.methods:
+                left += [f"{scene} {method} seed {seed} at {b}" for b in study.budgets_for(scene, seed)
+                         if not result_path(study, scene, method, seed, b).exists()]
+    return left
+
+
+def run_study(study: Study, progress: bool = True) -> None:
+    for scene, trunk, seed, upto in plan(study):
+        score_classical(study, scene)
+        run_trunk(study, scene, trunk, seed, upto, progress)
+        from experiments.study_report import write_report
+
+        write_report(study)
+
+
+def _write_json(path: pathlib.Path, doc) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with written_whole(path) as tmp:
+        tmp.write_text(json.dumps(doc, indent=1) + "\n")
+
+
+def _ints(text: str) -> tuple[int, ...]:
+    return tuple(int(t) for t in text.split(",") if t.strip())
+
+
+def main(argv=None) -> None:
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--scene", choices=(*SCENES, "both"), default="both")
+    p.add_argument("--seeds", type=_ints, help="seeds of every chosen scene (default: indoor 0,1,2; outdoor 0)")
+    p.add_argument("--images", type=int, default=30_000, help="the budget B of every run (default 30000)")
+    p.add_argument("--curve", type=_ints, help="budgets scored on the way; seed 0 goes on to the largest "
+                   "(default: indoor 10000,30000,100000; outdoor none)")
+    p.add_argument("--tune-images", type=int, default=3_000)
+    p.add_argument("--adv-images", type=int, default=2_000)
+    p.add_argument("--methods", help=f"comma-separated, of {','.join(METHODS)} (default: all)")
+    p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
+    p.add_argument("--root", default="runs/study", help="runs, models and scores (default runs/study)")
+    p.add_argument("--results", default="docs/results", help="where --report writes (default docs/results)")
+    p.add_argument("--workers", type=int, default=1, help="loader processes per run (default 1; 14 on a 16-core "
+                   "GPU host)")
+    p.add_argument("--tiny", action="store_true", help="tiny networks on 48x64 frames: a check, not a result")
+    p.add_argument("--plan", action="store_true", help="print what is done and what is left; run nothing")
+    p.add_argument("--report", action="store_true", help="write the report from the scores so far; train nothing")
+    p.add_argument("--no-progress", action="store_true")
+    args = p.parse_args(argv)
+    scenes = SCENES if args.scene == "both" else (args.scene,)
+    methods = tuple(m.strip() for m in args.methods.split(",")) if args.methods else METHODS
+    unknown = [m for m in methods if m not in METHODS]
+    if unknown:
+        p.error(f"unknown method(s) {unknown}; choose of {','.join(METHODS)}")
+    try:
+        study = Study(pathlib.Path(args.root), scenes, {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
+                      args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
+                      args.tune_images, args.adv_images, args.limit, args.tiny, methods, args.workers)
+    except ValueError as exc:
+        p.error(str(exc))
+    from experiments.study_report import write_report
+
+    if args.plan:
+        left = missing(study)
+        print("\n".join(f"{s} {t} seed {k} up to {n} images" for s, t, k, n in plan(study)))
+        print(f"{len(left)} scores left" + "".join(f"\n  {line}" for line in left))
+        return
+    enable_compilation_cache()
+    if not args.report:
+        run_study(study, progress=not args.no_progress)
+    write_report(study, pathlib.Path(args.results))
+
+
+if __name__ == "__main__":
+    sys.exit(run_main(PROG, main))

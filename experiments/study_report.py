@@ -1,0 +1,217 @@
+"""The equal-budget study's report (experiments/equal_budget.py): what its scores show so far.
+
+Writes into the results folder (docs/results by default):
+  equal_budget.json   {"indoor": {"<method>": {"images", "seeds", "rmse_m", "mae_m"}, "linear": {...},
+                       "nearest": {...}}, "outdoor": {...}, "details": {tuning, curve, iterations, paired tests}}
+  equal_budget.md     per scene, mean +- standard deviation over seeds at the budget, and the paired tests
+  equal_budget_curve.png        test RMSE against training images (the data-efficiency curve), rooms
+  equal_budget_iterations.png   test RMSE against the ADMM iteration count K of the LIP runs (Fig. 4a)
+
+Paired tests: per test frame, a method's RMSE averaged over the seeds both methods have at the budget; the Wilcoxon
+signed-rank test and the paired t-test over the frames (two-sided), for LIP+AD against the best end-to-end network
+and against LIP+CNN (the paper's adversarial claim), and the fast prox's LIP+AD against the best end-to-end network.
+"""
+from __future__ import annotations
+
+import json
+import pathlib
+import statistics
+
+import numpy as np
+
+from experiments.configs.study import END_TO_END, METHODS, SCENES
+from lipjax.utils import written_whole
+
+PAIRS = (("lip-ad", "best end-to-end"), ("lip-ad", "lip-cnn"), ("lip-ad-fast", "best end-to-end"))
+
+
+def load_scores(root: pathlib.Path, scene: str) -> list[dict]:
+    folder = root / scene / "results"
+    return [json.loads(p.read_text()) for p in sorted(folder.glob("*-seed*-*.json"))] if folder.exists() else []
+
+
+def at_budget(scores: list[dict], method: str, images: int) -> list[dict]:
+    return sorted((s for s in scores if s["method"] == method and s["images"] == images), key=lambda s: s["seed"])
+
+
+def scene_summary(scores: list[dict], classical: dict, images: int) -> dict:
+    """The equal_budget.json entry of one scene."""
+    out = {}
+    for method in METHODS:
+        runs = at_budget(scores, method, images)
+        if runs:
+            out[method] = {"images": images, "seeds": [r["seed"] for r in runs],
+                           "rmse_m": [r["rmse_m"] for r in runs], "mae_m": [r["mae_m"] for r in runs]}
+    for name in ("linear", "nearest"):
+        if name in classical:
+            out[name] = {"rmse_m": classical[name]["rmse_m"], "mae_m": classical[name]["mae_m"]}
+    return out
+
+
+def paired_test(scores: list[dict], a: str, b: str, images: int) -> dict | None:
+    """Method a against b over the test frames, each frame's RMSE the mean over the seeds both have."""
+    from scipy import stats
+
+    runs_a, runs_b = at_budget(scores, a, images), at_budget(scores, b, images)
+    seeds = sorted({r["seed"] for r in runs_a} & {r["seed"] for r in runs_b})
+    if not seeds:
+        return None
+
+    def per_frame(runs):
+        chosen = [r for r in runs if r["seed"] in seeds]
+        return np.mean([[p["rmse_m"] for p in r["per_image"]] for r in chosen], axis=0)
+
+    x, y = per_frame(runs_a), per_frame(runs_b)
+    if len(x) != len(y) or len(x) < 2:
+        return None
+    diff = x - y
+    return {"a": a, "b": b, "images": images, "seeds": seeds, "frames": int(len(x)),
+            "mean_rmse_a_m": float(x.mean()), "mean_rmse_b_m": float(y.mean()),
+            "a_better_frames": int((diff < 0).sum()), "b_better_frames": int((diff > 0).sum()),
+            "wilcoxon_p": float(stats.wilcoxon(x, y).pvalue) if np.any(diff) else 1.0,
+            "ttest_p": float(stats.ttest_rel(x, y).pvalue) if np.any(diff) else 1.0}
+
+
+def best_end_to_end(summary: dict) -> str | None:
+    present = [m for m in END_TO_END if m in summary]
+    return min(present, key=lambda m: statistics.mean(summary[m]["rmse_m"])) if present else None
+
+
+def curve(scores: list[dict]) -> dict:
+    """{method: {images: [test RMSE per seed]}}."""
+    out: dict = {}
+    for s in scores:
+        out.setdefault(s["method"], {}).setdefault(str(s["images"]), []).append(s["rmse_m"])
+    return out
+
+
+def iterations(scores: list[dict], images: int) -> dict:
+    """{LIP method: {K: [test RMSE per seed]}} at the budget (Fig. 4a)."""
+    out: dict = {}
+    for s in scores:
+        if s["images"] == images and s.get("rmse_m_by_iterations"):
+            for k, v in s["rmse_m_by_iterations"].items():
+                out.setdefault(s["method"], {}).setdefault(k, []).append(v)
+    return out
+
+
+def _mean_std(values: list[float], digits: int = 4) -> str:
+    if len(values) == 1:
+        return f"{values[0]:.{digits}f}"
+    return f"{statistics.mean(values):.{digits}f} ± {statistics.stdev(values):.{digits}f}"
+
+
+def markdown(doc: dict, images: int) -> str:
+    lines = [f"# The equal-budget study ({images:,} training images per run)", ""]
+    for scene in SCENES:
+        summary = doc.get(scene)
+        if not summary:
+            continue
+        linear = summary.get("linear", {}).get("rmse_m")
+        lines += [f"## {'Table I, rooms, 200 points' if scene == 'indoor' else 'Table II, streets, 64 beams'}", "",
+                  "| method | images | seeds | RMSE m | MAE m | RMSE / linear |", "|---|---:|---|---:|---:|---:|"]
+        for method, row in summary.items():
+            if "seeds" in row:
+                ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
+                lines.append(f"| {method} | {row['images']:,} | {','.join(map(str, row['seeds']))} | "
+                             f"{_mean_std(row['rmse_m'])} | {_mean_std(row['mae_m'])} | {ratio} |")
+            else:
+                lines.append(f"| {method} (no training) | | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
+                             f"{row['rmse_m'] / linear:.2f}x |")
+        tests = doc["details"][scene]["paired_tests"]
+        if tests:
+            lines += ["", "| paired test | seeds | frames | mean RMSE a / b m | a better on | Wilcoxon p | t-test p |",
+                      "|---|---|---:|---:|---:|---:|---:|"]
+            lines += [f"| {t['a']} vs {t['b']} | {','.join(map(str, t['seeds']))} | {t['frames']} | "
+                      f"{t['mean_rmse_a_m']:.4f} / {t['mean_rmse_b_m']:.4f} | {t['a_better_frames']} | "
+                      f"{t['wilcoxon_p']:.2g} | {t['ttest_p']:.2g} |" for t in tests]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6, 4), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for method in METHODS:
+        if method not in curves:
+            continue
+        xs = sorted(curves[method], key=int)
+        mean = [statistics.mean(curves[method][x]) for x in xs]
+        line, = ax.plot([int(x) for x in xs], mean, marker="o", label=method)
+        lo = [min(curves[method][x]) for x in xs]
+        hi = [max(curves[method][x]) for x in xs]
+        ax.fill_between([int(x) for x in xs], lo, hi, color=line.get_color(), alpha=0.15)
+    for name, style in (("linear", "--"), ("nearest", ":")):
+        if name in classical:
+            ax.axhline(classical[name]["rmse_m"], color="grey", linestyle=style, label=f"{name} fill")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("training images")
+    ax.set_ylabel("test RMSE (m), mean over seeds, band min-max")
+    ax.set_title(title)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def plot_iterations(path: pathlib.Path, per_k: dict, title: str) -> None:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(5, 3.6), dpi=120)
+    FigureCanvasAgg(fig)
+    ax = fig.add_subplot()
+    for method, by_k in per_k.items():
+        ks = sorted(by_k, key=int)
+        mean = np.array([statistics.mean(by_k[k]) for k in ks])
+        std = np.array([statistics.stdev(by_k[k]) if len(by_k[k]) > 1 else 0.0 for k in ks])
+        line, = ax.plot([int(k) for k in ks], mean, marker="o", label=f"{method} ({len(by_k[ks[0]])} seeds)")
+        ax.fill_between([int(k) for k in ks], mean - std, mean + std, color=line.get_color(), alpha=0.2)
+    ax.set_xlabel("ADMM iterations K")
+    ax.set_ylabel("test RMSE (m), mean ± std over seeds")
+    ax.set_xticks(sorted({int(k) for by_k in per_k.values() for k in by_k}))
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+
+
+def write_report(study, out: pathlib.Path | None = None) -> dict:
+    """Writes the report of `study` (an experiments.equal_budget.Study) into `out` (default: <root>/report)."""
+    out = pathlib.Path(out) if out is not None else study.root / "report"
+    out.mkdir(parents=True, exist_ok=True)
+    doc: dict = {"details": {}}
+    for scene in SCENES:
+        scores = load_scores(study.root, scene)
+        classical_path = study.root / scene / "results" / "classical.json"
+        classical = json.loads(classical_path.read_text()) if classical_path.exists() else {}
+        if not scores:
+            continue
+        summary = scene_summary(scores, classical, study.images)
+        doc[scene] = summary
+        best = best_end_to_end(summary)
+        tests = [paired_test(scores, a, best if b == "best end-to-end" else b, study.images)
+                 for a, b in PAIRS if (best or b != "best end-to-end")]
+        tuning_path = study.root / scene / "tuning.json"
+        doc["details"][scene] = {
+            "tuning_val_rmse_m": json.loads(tuning_path.read_text()) if tuning_path.exists() else {},
+            "curve_rmse_m": curve(scores), "rmse_m_by_iterations": iterations(scores, study.images),
+            "paired_tests": [t for t in tests if t], "test_frames": len(scores[0]["per_image"]),
+        }
+        names = {"indoor": "rooms, 200 points (Table I)", "outdoor": "streets, 64 beams (Table II)"}
+        plot_curve(out / f"equal_budget_curve_{scene}.png", curve(scores), classical, names[scene])
+        if doc["details"][scene]["rmse_m_by_iterations"]:
+            plot_iterations(out / f"equal_budget_iterations_{scene}.png", doc["details"][scene][
+                "rmse_m_by_iterations"], f"{names[scene]}, {study.images:,} images")
+    for name, text in (("equal_budget.json", json.dumps(doc, indent=1) + "\n"),
+                       ("equal_budget.md", markdown(doc, study.images))):
+        with written_whole(out / name) as tmp:
+            tmp.write_text(text)
+    print(f"[study] report in {out}: equal_budget.json, equal_budget.md and figures", flush=True)
+    return doc

@@ -1,0 +1,135 @@
+"""The equal-budget study (experiments/equal_budget.py): budgets and order, the constant schedule it relies on, the
+end-to-end networks' depth unit, the paired tests, and one tiny study end to end (resumed, then reported)."""
+import dataclasses
+import json
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+import lipjax
+from scipy import stats
+
+from experiments import equal_budget, study_report
+from experiments.configs.study import BRANCH_SEED_OFFSET, branch_config, trunk_config
+from lipjax.networks import baseline_preset
+from lipjax.train.state import g_learning_rate
+
+
+def study(tmp_path, **kw):
+    defaults = dict(scenes=("indoor",), seeds={"indoor": (0, 1)}, images=32, curve={"indoor": (16, 32, 48)},
+                    tune_images=16, adv_images=8, limit=1, tiny=True)
+    return equal_budget.Study(tmp_path, **{**defaults, **kw})
+
+
+def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
+    s = study(tmp_path)
+    assert s.budgets_for("indoor", 1) == [16, 32]
+    assert s.budgets_for("indoor", 0) == [16, 32, 48]
+    steps = equal_budget.plan(s)
+    # every seed reaches B before seed 0 goes on past it
+    first_past_b = next(i for i, step in enumerate(steps) if step[3] > 32)
+    assert all(step[3] == 32 for step in steps[:first_past_b])
+    assert {(t, k) for _, t, k, n in steps if n == 32} == {(t, k) for t in ("ma2018", "unet", "cspn", "lip-cnn",
+                                                                          "lip-fast") for k in (0, 1)}
+    assert [(t, k, n) for _, t, k, n in steps[first_past_b:]] == [(t, 0, 48) for t in ("ma2018", "unet", "cspn",
+                                                                                      "lip-cnn", "lip-fast")]
+    with pytest.raises(ValueError, match="multiples of the batch size"):
+        study(tmp_path, images=30)
+    with pytest.raises(ValueError, match="below the smallest budget"):
+        study(tmp_path, adv_images=16)
+
+
+def test_a_branch_reads_its_budget_of_images_on_a_stream_of_its_own():
+    trunk = trunk_config("lip-cnn", "indoor", learning_rate=5e-4, seed=2, steps=3750)
+    branch = branch_config("lip-ad", trunk, "start", 2000)
+    assert (branch.d_steps, branch.adv_steps, branch.g_steps) == (50, 200, 0)  # the paper's LIP+AD split
+    assert branch.total_steps * branch.batch_size == 2000
+    assert branch.seed == 2 + BRANCH_SEED_OFFSET and branch.learning_rate == trunk.learning_rate
+    assert branch.name == "study-lip-ad-indoor" and branch.init_from == "start"
+    fast = branch_config("lip-ad-fast", trunk_config("lip-fast", "indoor", learning_rate=5e-4, seed=0, steps=10),
+                         "start", 2000)
+    assert fast.name == "study-lip-ad-fast-indoor" and fast.discriminator.inputs == "log_gradients"
+
+
+def test_constant_schedule_holds_the_rate_after_warm_up_whatever_the_run_length():
+    for steps in (300, 3000):
+        config = dataclasses.replace(trunk_config("ma2018", "indoor", learning_rate=1e-3, seed=0, steps=steps))
+        lr = g_learning_rate(config)
+        assert float(lr(0)) == 0.0 and float(lr(50)) == pytest.approx(5e-4)  # linear warm-up over 100 steps
+        assert [float(lr(s)) for s in (100, 299, 2999)] == pytest.approx([1e-3] * 3)
+    cosine = g_learning_rate(dataclasses.replace(config, schedule="cosine"))
+    assert float(cosine(2999)) == pytest.approx(0.05e-3, rel=1e-3)  # the default still decays to 5 %
+    with pytest.raises(ValueError, match="schedule must be one of"):
+        dataclasses.replace(config, schedule="step")
+
+
+@pytest.mark.parametrize("model_type", ["unet", "cspn", "sparse_to_dense"])
+def test_depth_in_units_of_the_samples_makes_a_network_scale_equivariant(model_type):
+    """depth_scale "samples": f(rgb, c * s) = c * f(rgb, s) exactly (up to float rounding) for every c > 0, so no
+    frame's absolute depth has to pass through the network; "max_depth" has no such property."""
+    h, w = 32, 32
+    rng = np.random.default_rng(0)
+    rgb = jnp.asarray(rng.integers(0, 256, (1, h, w, 3)), jnp.uint8)
+    sparse = np.zeros((1, h, w), np.float32)
+    idx = rng.choice(h * w, 40, replace=False)
+    sparse.reshape(-1)[idx] = rng.uniform(1.0, 6.0, 40)
+    for scale, equivariant in (("samples", True), ("max_depth", False)):
+        model = dataclasses.replace(baseline_preset(model_type, "tiny"), depth_scale=scale)
+        params = model.init(jax.random.key(0))
+        a = np.asarray(model.apply(params, rgb, jnp.asarray(sparse))[0])
+        b = np.asarray(model.apply(params, rgb, jnp.asarray(3.0 * sparse))[0])
+        assert np.allclose(b, 3.0 * a, rtol=1e-4, atol=1e-5 * np.abs(b).max()) == equivariant, scale
+    with pytest.raises(ValueError, match="depth_scale must be one of"):
+        dataclasses.replace(baseline_preset("unet", "tiny"), depth_scale="inches")
+
+
+def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
+    rng = np.random.default_rng(1)
+    frames = 12
+
+    def runs(method, offset):
+        return [{"method": method, "images": 32, "seed": k,
+                 "per_image": [{"rmse_m": float(v)} for v in rng.uniform(0.2, 0.4, frames) + offset]}
+                for k in (0, 1)]
+
+    a, b = runs("lip-ad", 0.0), runs("unet", 0.05)
+    got = study_report.paired_test(a + b, "lip-ad", "unet", 32)
+    x = np.mean([[p["rmse_m"] for p in r["per_image"]] for r in a], axis=0)
+    y = np.mean([[p["rmse_m"] for p in r["per_image"]] for r in b], axis=0)
+    assert got["wilcoxon_p"] == pytest.approx(stats.wilcoxon(x, y).pvalue)
+    assert got["ttest_p"] == pytest.approx(stats.ttest_rel(x, y).pvalue)
+    assert got["a_better_frames"] == int((x < y).sum()) and got["seeds"] == [0, 1] and got["frames"] == frames
+    assert study_report.paired_test(a, "lip-ad", "unet", 32) is None  # no run of b: no test
+
+
+def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(equal_budget, "TUNE_LRS", (5e-4, 1e-3))  # two rates: a choice, in fewer compiles
+    args = ["--tiny", "--root", str(tmp_path / "study"), "--results", str(tmp_path / "report"), "--scene", "indoor",
+            "--seeds", "0", "--images", "96", "--curve", "48,96", "--tune-images", "16", "--adv-images", "40",
+            "--limit", "2", "--methods", "lip-cnn,lip-ad", "--no-progress"]
+    equal_budget.main(args)
+    results = tmp_path / "study" / "indoor" / "results"
+    names = sorted(p.name for p in results.glob("*-seed*-*.json"))
+    assert names == sorted(f"{m}-seed0-{n}.json" for m in ("lip-cnn", "lip-ad") for n in (48, 96))
+    for name in names:  # each score is of a model that read exactly its budget
+        doc = json.loads((results / name).read_text())
+        assert doc["images_seen"] == doc["images"] and len(doc["per_image"]) == 2
+    lip = json.loads((results / "lip-cnn-seed0-96.json").read_text())
+    k = str(lip["metrics"].get("iterations", 3))
+    assert set(lip["rmse_m_by_iterations"]) == {"1", "2", "3"}  # Fig. 4a: every K of the 3-iteration solver
+    assert lip["rmse_m_by_iterations"][k] == lip["rmse_m"]
+    tuning = json.loads((tmp_path / "study" / "indoor" / "tuning.json").read_text())["lip-cnn"]
+    chosen = min(tuning, key=lambda lr: tuning[lr]["val_rmse_m"])  # the trunk ran at the rate tuning chose
+    assert lipjax.load_model(lip["model"]).metadata["learning_rate"] == float(chosen)
+    report = json.loads((tmp_path / "report" / "equal_budget.json").read_text())
+    assert report["indoor"]["lip-ad"]["images"] == 96 and report["indoor"]["lip-ad"]["seeds"] == [0]
+    assert set(report["indoor"]) == {"lip-cnn", "lip-ad", "linear", "nearest"}
+    assert report["details"]["indoor"]["paired_tests"][0]["b"] == "lip-cnn"  # no end-to-end network ran
+    assert (tmp_path / "report" / "equal_budget_curve_indoor.png").stat().st_size > 0
+    before = {p: p.stat().st_mtime_ns for p in results.glob("*.json")}
+    capsys.readouterr()
+    equal_budget.main(args)  # everything is done: nothing is trained or scored again
+    assert {p: p.stat().st_mtime_ns for p in results.glob("*.json")} == before
+    assert "test rmse_m" not in capsys.readouterr().out
