@@ -3,62 +3,51 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
 
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)] [--threads N]
-                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all] [--[no-]mirror] [--no-cross-check]
+                    [--uncertainty FILE] [--max-uncertainty M] [--fill-all | --blank-unsupported]
+                    [--[no-]mirror] [--no-cross-check]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model M] --height H --width W [--batch B] [--samples N] [--scattered] [--[no-]mirror] --out F
-    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N]  (fine-tune on your frames)
+    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N] [--keep best|last]
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
 
 Run `lipjax COMMAND --help` for a command's options.
 """
-# For developers: each subcommand is an `_add_<name>_parser` and a `_cmd_<name>(args)` that passes its arguments to
-# one library function (lipjax.files, lipjax.evaluate, lipjax.export, lipjax.train.run, lipjax.data.rendered).
+# Each subcommand: `_add_<name>_parser`, and `_cmd_<name>(args)` calling one library function it imports (quick --help)
 from __future__ import annotations
 
 import argparse
 import sys
 
 from lipjax import __version__, console
-from lipjax.data.folder import OUT_FORMATS, parse_depth_scale
-from lipjax.data.protocols import PROTOCOLS
-from lipjax.data.rendered import render_to_disk
-from lipjax.data.sources import NO_PROTOCOL, SOURCES
-from lipjax.data.synthetic import SPLITS, SYNTHETIC_KINDS
-from lipjax.evaluate import DEFAULT_COLUMNS, evaluate_methods, markdown_table, save_json
-from lipjax.export import export
-from lipjax.files import COMPLETE_HELP, READ_WORKERS, complete_files, project_file
-from lipjax.methods import CLASSICAL
-from lipjax.model_io import listing
-from lipjax.train.folder import FOLDER_BATCH_SIZE, FOLDER_DATA, FOLDER_STEPS
-from lipjax.train.run import fine_tune_folder
-from lipjax.utils import enable_compilation_cache, limit_cpu_threads
+from lipjax.cli_help import (CLASSICAL, COMPLETE_HELP, DEFAULT_COLUMNS, NO_PROTOCOL, OUT_FORMATS, PROTOCOLS, SOURCES,
+                             SPLITS, SYNTHETIC_KINDS, TRAINING, depth_scale)
 
 PROG = "lipjax"
 _RAW, _BOOL = argparse.RawDescriptionHelpFormatter, argparse.BooleanOptionalAction
-_depth_scale = console.argument_type(parse_depth_scale)  # --depth-scale: 256, 1000, kitti, nyu, ...
 
 
 def _cmd_complete(args) -> int:
+    from lipjax import files, utils
     if args.threads:
-        limit_cpu_threads(args.threads)
-    done = complete_files(
-        args.rgb, args.depth, args.out, lidar=args.lidar, calib=args.calib, camera=args.camera,
-        depth_scale=args.depth_scale, model=args.model, iterations=args.iterations, max_side=args.max_side,
-        out_format=args.out_format, color_range=args.color_range, ply=args.ply, cross_check=args.cross_check,
-        intrinsics=args.intrinsics or args.intrinsics_file, uncertainty=args.uncertainty,
-        max_uncertainty=args.max_uncertainty, fill_all=args.fill_all, mirror=args.mirror, progress=not args.quiet,
-        log=None if args.quiet else console.say, workers=min(args.threads or READ_WORKERS, READ_WORKERS))
+        utils.limit_cpu_threads(args.threads)
+    done = files.complete_files(
+        args.rgb, args.depth, args.out, intrinsics=args.intrinsics or args.intrinsics_file, progress=not args.quiet,
+        log=None if args.quiet else console.say, workers=min(args.threads or files.READ_WORKERS, files.READ_WORKERS),
+        **{k: getattr(args, k) for k in ("lidar", "calib", "camera", "depth_scale", "model", "iterations", "max_side",
+                                         "out_format", "color_range", "ply", "cross_check", "uncertainty",
+                                         "max_uncertainty", "fill_all", "blank_unsupported", "mirror")})
     if not args.quiet:
         console.say(done.summary())
     return 0
 
 
 def _cmd_project(args) -> int:
+    from lipjax.files import project_file
     done = project_file(args.rgb, args.lidar, args.calib, args.out, camera=args.camera, depth_scale=args.depth_scale)
     if not args.quiet:
         console.say(done.summary())
@@ -66,13 +55,13 @@ def _cmd_project(args) -> int:
 
 
 def _cmd_evaluate(args) -> int:
+    from lipjax.evaluate import evaluate_methods, markdown_table, save_json
     columns = tuple(c.strip() for c in args.columns.split(",")) if args.columns else DEFAULT_COLUMNS
     report = evaluate_methods(
-        args.model, iterations=args.iterations, min_depth_m=args.min_depth_m, max_depth_m=args.max_depth_m,
-        limit=args.limit, seed=args.seed, progress=not args.quiet, data=args.data, source=args.source,
-        root=args.root, raw_root=args.raw_root, split=args.split, kind=args.kind, size=args.size,
-        sampler=args.sampler, protocol=args.protocol, depth_scale=args.depth_scale, working_size=args.working_size,
-        intrinsics=args.intrinsics or args.intrinsics_file)
+        args.model, progress=not args.quiet, intrinsics=args.intrinsics or args.intrinsics_file,
+        **{k: getattr(args, k) for k in ("iterations", "min_depth_m", "max_depth_m", "limit", "seed", "data", "source",
+                                         "root", "raw_root", "split", "kind", "size", "sampler", "protocol",
+                                         "depth_scale", "working_size")})
     print(report.header() + "\n\n" + markdown_table(report.results, columns=columns))
     if args.json:
         save_json(report.results, args.json)
@@ -80,6 +69,7 @@ def _cmd_evaluate(args) -> int:
 
 
 def _cmd_export(args) -> int:
+    from lipjax.export import export
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     try:
         written = export(args.model, args.out, iterations=args.iterations, platforms=platforms, **{
@@ -92,6 +82,7 @@ def _cmd_export(args) -> int:
 
 
 def _cmd_data_render(args) -> int:
+    from lipjax.data.rendered import render_to_disk
     try:
         out = render_to_disk(args.kind, args.split, args.count, args.out, height=args.height, width=args.width,
                              window=args.window, workers=args.workers, progress=not args.quiet)
@@ -104,10 +95,17 @@ def _cmd_data_render(args) -> int:
 
 
 def _cmd_train(args) -> int:
+    from lipjax.train.run import fine_tune_folder
     fine_tune_folder(args.data, args.out, init=args.init, steps=args.steps, batch_size=args.batch_size,
                      workdir=args.workdir, progress=not args.quiet, log=None if args.quiet else console.say,
                      depth_scale=args.depth_scale, num_workers=args.workers, crop=args.crop and tuple(args.crop),
-                     train_sampler=args.sampler)
+                     train_sampler=args.sampler, keep=args.keep)
+    return 0
+
+
+def _cmd_models(args) -> int:
+    from lipjax.methods import listing
+    print(listing())
     return 0
 
 
@@ -126,20 +124,18 @@ def _add_lidar_args(p, required: bool) -> None:
     """--lidar, --calib, --camera: of `project`, and of `complete` as the alternative to --depth."""
     p.add_argument("--lidar", required=required, metavar="SWEEP",
                    help="LiDAR sweep: KITTI .bin, .npy (N, >=3) x y z metres, or .pcd")
-    p.add_argument("--calib", required=required, metavar="FILE",
-                   help="KITTI object calib .txt, KITTI raw date folder, KITTI odometry calib.txt, or a rig "
-                        ".txt/.yaml with K and T_cam_from_lidar")
+    p.add_argument("--calib", required=required, metavar="FILE", help="KITTI object calib .txt, KITTI raw date "
+                   "folder, KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar")
     p.add_argument("--camera", type=int, default=2, metavar="N", help="KITTI camera of --rgb: 2 (image_2) or 3")
 
 
 def _add_complete_parser(sub) -> None:
     c = sub.add_parser("complete", help="complete sparse depth of your own frames", formatter_class=_RAW,
-                       description="Completes the sparse depth of your own frames.\n\nInputs and outputs:\n"
-                                   + COMPLETE_HELP)
+                       description=COMPLETE_HELP)
     c.add_argument("--rgb", required=True, help="colour image (.png/.jpg) or a folder of them")
     c.add_argument("--depth", help="sparse depth: 16-bit .png (needs --depth-scale) or .npy metres; or a folder")
     _add_lidar_args(c, required=False)
-    c.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="PNG value per metre: 256 (kitti), "
+    c.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG value per metre: 256 (kitti), "
                    "1000 (nyu), 5000 (tum); required by .png input (no default); .png output: 256 when not given")
     _add_model_args(c, f"shipped model (lipjax models), saved model path or classical fill ({', '.join(CLASSICAL)})")
     c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
@@ -153,7 +149,9 @@ def _add_complete_parser(sub) -> None:
     c.add_argument("--uncertainty", metavar="FILE",
                    help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
-    c.add_argument("--fill-all", action="store_true", help="keep the depth where no sample supports it (default: 0)")
+    where = c.add_mutually_exclusive_group()  # neither: what the model or method returns, as lipjax.complete
+    where.add_argument("--fill-all", action="store_true", help="depth at every pixel (0s a method leaves: nearest)")
+    where.add_argument("--blank-unsupported", action="store_true", help="0 where no sample supports the depth")
     c.add_argument("--mirror", action=_BOOL, help="learned models: average in the mirror image (default: scan lines)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     c.add_argument("--threads", type=console.positive_int, metavar="N",
@@ -170,7 +168,7 @@ def _add_project_parser(sub) -> None:
     p.add_argument("--rgb", required=True, help="the camera's image (gives the size)")
     p.add_argument("--out", required=True,
                    help="SPARSE.npy (float32 metres) | .png (16-bit, value = metres * --depth-scale) | .color.png")
-    p.add_argument("--depth-scale", type=_depth_scale, metavar="S",
+    p.add_argument("--depth-scale", type=depth_scale, metavar="S",
                    help="PNG value per metre of .png output (default 256, KITTI's)")
     p.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     p.set_defaults(func=_cmd_project)
@@ -200,7 +198,7 @@ def _add_evaluate_parser(sub) -> None:
                    "sparse/, else uniform:200")
     e.add_argument("--protocol", choices=sorted(PROTOCOLS) + [NO_PROTOCOL], help="named crop/resize + depth range "
                    "applied to each frame; none: frames as they are (with --source, still the source's depth range)")
-    e.add_argument("--depth-scale", type=_depth_scale, metavar="S",
+    e.add_argument("--depth-scale", type=depth_scale, metavar="S",
                    help="PNG depth value per metre in FOLDER (or --source folder)")
     _add_intrinsics_args(e)
     e.add_argument("--working-size", action="store_true", help="score models as `lipjax complete` runs them: at "
@@ -212,7 +210,7 @@ def _add_evaluate_parser(sub) -> None:
     e.add_argument("--seed", type=int, default=0, help="sampler seed")
     e.add_argument("--columns", help=f"comma-separated metric names (default: {','.join(DEFAULT_COLUMNS)})")
     e.add_argument("--json", metavar="FILE", help="also write all results as JSON")
-    e.add_argument("--quiet", action="store_true")
+    e.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=_cmd_evaluate)
 
 
@@ -227,7 +225,7 @@ def _add_export_parser(sub) -> None:
     x.add_argument("--mirror", action=_BOOL, help=".onnx: as lipjax complete's, in the graph (default: scan lines)")
     x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
-    x.add_argument("--quiet", action="store_true")
+    x.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     x.set_defaults(func=_cmd_export)
 
 
@@ -244,7 +242,7 @@ def _add_data_parser(sub) -> None:
     r.add_argument("--window", type=console.positive_int, nargs=2, metavar=("H", "W"),
                    help="store one HxW window per frame, rendered directly at the training crop size")
     r.add_argument("--workers", type=console.positive_int, help="processes (default: every core)")
-    r.add_argument("--quiet", action="store_true")
+    r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=_cmd_data_render)
 
 
@@ -255,18 +253,20 @@ def _add_train_parser(sub) -> None:
                         "and val/ holding them")
     t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
                    "complete --model OUT)")
-    t.add_argument("--depth-scale", type=_depth_scale, metavar="S", help="PNG depth value per metre")
+    t.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", help="model to start from: shipped name or saved path (default: the "
                    "default model of the frames' scene, as lipjax complete picks it)")
-    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {FOLDER_STEPS})")
-    t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {FOLDER_BATCH_SIZE})")
+    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {TRAINING.steps})")
+    t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {TRAINING.batch_size})")
     t.add_argument("--sampler", help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps")
     t.add_argument("--crop", type=console.positive_int, nargs=2, metavar=("H", "W"),
-                   help=f"random training crops (default {' '.join(map(str, FOLDER_DATA.crop))})")
-    t.add_argument("--workers", type=int, help=f"loader worker processes (0: none; default {FOLDER_DATA.num_workers})")
+                   help=f"random training crops (default {TRAINING.crop[0]} {TRAINING.crop[1]})")
+    t.add_argument("--workers", type=int, help=f"loader processes (0: none; default {TRAINING.workers})")
+    t.add_argument("--keep", choices=("best", "last"), default="best", help="if the trained model validates worse "
+                   "than its start: export the start (best, default) or the trained model anyway (last)")
     t.add_argument("--workdir", help="checkpoints and logs (default runs/train-<--out name>)")
-    t.add_argument("--quiet", action="store_true")
+    t.add_argument("-q", "--quiet", action="store_true", help="no progress bar or log lines")
     t.set_defaults(func=_cmd_train)
 
 
@@ -274,16 +274,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser = console.ArgumentParser(prog=PROG, description=__doc__, formatter_class=_RAW)
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for add in (_add_complete_parser, _add_project_parser, _add_evaluate_parser, _add_export_parser):
+    for add in (_add_complete_parser, _add_project_parser, _add_evaluate_parser, _add_export_parser, _add_data_parser,
+                _add_train_parser):
         add(sub)
-    sub.add_parser("models", help="list the shipped models").set_defaults(func=lambda args: print(listing()))
-    _add_data_parser(sub)
-    _add_train_parser(sub)
+    sub.add_parser("models", help="list the shipped models and hand-crafted methods").set_defaults(func=_cmd_models)
     return parser
 
 
 def _run(argv: list[str]) -> int:
     args = build_parser().parse_args(argv)
+    from lipjax.utils import enable_compilation_cache  # after parsing: --help loads no JAX
     try:
         enable_compilation_cache()
     except OSError as exc:

@@ -18,19 +18,19 @@ it). Otherwise, over all n:
 and every measured pixel is set back. Where the model is the better fill (the renders of
 `benchmarks/generalisation.py` with the 972,640-image lip-any: 0.662612 -> 0.662305 x linear) w stays 1 on most
 frames (it fires on some denser inputs); where it is not (a street model on rooms: 1.23 -> 0.90 x linear) the output
-leans on the linear fill. Folds, not one held-out fifth (rule 52 of docs/design-notes.md): with 200 points one fifth
-is 40 depths, too few for the test to see a model that loses (one fold: 0.662356 and 0.98 above). Scan lines are not
-checked: random held-out returns lie a pixel from their neighbours on the same line, where every fill is right, so
-they say nothing of the gaps between the lines (and the LiDAR path keeps its 10 frames/s). Nor is dense input (over
-`lipjax.resolution.DENSE` samples per pixel: a depth camera's, stereo's), for the same reason: rule 49 of
-docs/design-notes.md measured rooms with holes 0.9297 x linear unchecked against 0.9488 checked, and the check cost
-two Delaunay fills of most of the frame's pixels. The held-out runs use the working size the default path gives the
-kept samples (`held_out_size`, rule 48 of docs/design-notes.md): the model sees them as far apart as it was trained
-to, in 0.8x the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames only,
-by rules fixed before measuring (docs/design-notes.md, "A check against the linear fill", "The check on every
-sample" and "The check's time"). Costs one more run of the model, FOLDS where the first fold goes against it (twice
-as many with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires;
-`cross_check=False` (lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
+leans on the linear fill. Folds, not one held-out fifth (docs/decisions/0015-cross-check-by-folds.md): with 200 points
+one fifth is 40 depths, too few for the test to see a model that loses (one fold: 0.662356 and 0.98 above). Scan lines
+are not checked: random held-out returns lie a pixel from their neighbours on the same line, where every fill is right,
+so they say nothing of the gaps between the lines (and the LiDAR path keeps its 10 frames/s). Nor is dense input (over
+`lipjax.resolution.DENSE` samples per pixel: a depth camera's, stereo's), for the same reason: rooms with holes scored
+0.9297 x linear unchecked against 0.9488 checked, and the check cost two Delaunay fills of most of the frame's pixels
+(docs/decisions/0016-dense-input-not-checked.md). The held-out runs use the working size the default path gives the
+kept samples (`held_out_size`, docs/decisions/0014-held-out-run-size.md): the model sees them as far apart as it was
+trained to, in 0.8x the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames
+only, by rules fixed before measuring (docs/decisions/0013-cross-check-against-the-linear-fill.md,
+0015-cross-check-by-folds.md). Costs one more run of the model, FOLDS where the first fold goes against it (twice as
+many with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires; `cross_check=False`
+(lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
 XLA runs these models on about one of two CPU cores (480x640 with 200 points, training paused: the frame's and the
 first fold's estimates took 26 and 22 ms one after the other, 29 ms together in two threads), so the first fold runs
 in a second thread beside the frame's own estimate, and the other folds run side by side too (`_FOLDS_BESIDE`).
@@ -120,7 +120,7 @@ def cross_checked(estimate: Callable[[np.ndarray, tuple[int, int]], np.ndarray],
     y, x_l = [sparse_m[rows, cols]], [linear_fill_at(kept, rows, cols)]  # while the fold may still run
     x_m = [first.result()[rows, cols]]
     if 2 * misses_more(y[0], x_m[0], x_l[0]) <= rows.size:
-        return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds are not run (rule 53)
+        return z, 1.0  # k <= n / 2 on the first fold: the model fits, the other folds do not run (docs/decisions/0015)
     rest = list(folds)
     beside = [_FOLDS_BESIDE.submit(quietly, estimate, kept, at) for kept, _, _ in rest]
     for (kept, rows, cols), z_kept in zip(rest, (future.result() for future in beside)):

@@ -6,14 +6,17 @@
     print(project_file("image.png", "sweep.bin", "calib.txt", "sparse.npy").summary())      # a LiDAR sweep
 
 Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
---help describes the formats), and its errors name those flags.
+--help, lipjax.cli_help.COMPLETE_HELP, describes the formats), and its errors name those flags. By default a frame's
+output is what `lipjax.complete` returns for it (lipjax.methods.complete: the model's or method's depth as it gives
+it); `fill_all` and `blank_unsupported` change both the same way. The folders the outputs go to are checked
+writable before anything is read or run (`check_writable`).
 
 A folder overlaps reading, the model and writing: worker threads read and decode the next frames (OpenCV and numpy's
 file reads release the GIL); the model runs on the first frame in the calling thread (one compilation), then on
 MODEL_THREADS frames at once in threads of their own (XLA runs a model on about one core); one background thread
 post-processes (uncertainty, the support mask) and writes each completed frame, in order. The model is loaded once and
-compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames (`python
-benchmarks/folder_speed.py --keep DIR`, lip-any at 132x455) on the 2-core machine with training paused, a folder ran
+compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames (`python -m
+benchmarks.folder_speed --keep DIR`, lip-any at 132x455) on the 2-core machine with training paused, a folder ran
 at 1.06-1.18x the warm single-frame rate (3 runs; single frame 32-35 ms); one frame at a time it ran at 0.86-0.90x in
 the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Since the default path averages in the mirror
 image on scan lines (lipjax.inference.mirrors), each frame keeps both cores busy itself, and the folder ran at
@@ -46,8 +49,10 @@ from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, outp
                                 read_intrinsics, read_rgb, write_depth)
 from lipjax.data.lidar import project_sweep, read_lidar_frame
 from lipjax.data.sample import Intrinsics
+from lipjax.classical import fill_holes
 from lipjax.inference import CROSS_CHECK, Completer, complete_frame, frame_size
-from lipjax.inputs import scene_reason
+from lipjax.inputs import (SCENE_MEDIAN_M, check_depth_scale, is_lidar_pattern, likely_units, scene_reason,
+                           unit_hint)
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
 from lipjax.pointcloud import IntrinsicsLike, ProjectionCounts, backproject_rgbd, write_ply
@@ -57,67 +62,6 @@ from lipjax.viz import fitting_range
 
 DEFAULT_PNG_OUT_SCALE = KNOWN_DEPTH_SCALES["kitti"]
 """PNG value per metre of .png output when no depth scale was given (KITTI's)."""
-COMPLETE_HELP = """\
-  --rgb     colour image (.png / .jpg), or a folder of them.
-  --depth   sparse depth aligned pixel for pixel with the RGB image, 0 = no sample, or a folder of them:
-              .png  16-bit, metres = value / S with S = --depth-scale (KITTI 256, NYU 1000, TUM 5000; also the
-                    names kitti, nyu, tum). A PNG holds no unit, so --depth-scale is required for PNG input.
-              .npy  float metres (never scaled; --depth-scale then only sets the scale of .png output).
-  --lidar   instead of --depth: a LiDAR sweep (KITTI .bin, .npy (N, >=3) x y z metres, or .pcd), projected into
-            the image with --calib (the nearest point per pixel): KITTI object calib .txt, a KITTI raw date
-            folder, a KITTI odometry calib.txt, or a rig .txt/.yaml with K and T_cam_from_lidar; --camera picks
-            KITTI's image (2 = image_2, the default; 3 = image_3). The calibration's intrinsics serve --ply too.
-  --out     the extension chooses the format:
-              X.npy        float32 metres.
-              X.png        16-bit PNG, value = round(metres * S), S = --depth-scale, or 256 when none was given
-                           (npy input); values above 65535 are clipped, with a warning.
-              X.color.png  8-bit colour picture (turbo colour map) over --color-range; by default 0 m to the
-                           model's max depth (10 m indoor, 85 m outdoor), or to the output's 99th percentile
-                           when that is beyond the model's range or under a quarter of it (with folders, the
-                           first frame's); black = no depth.
-            With folders, OUT is a folder and gets one file per frame, <rgb stem>.<--out-format>
-            (npy | png | color.png; default: png when the depth inputs are PNG, else npy).
-            Folder frames are paired by file stem, or, when no stem matches, by the number the stems end with
-            (rgb_00050.jpg <-> sync_depth_00050.png). The next frames are read while the model runs (on two
-            frames at once after the first), outputs are written in the background, and the summary line gives
-            frames/s. A frame that fails stops the run with the frames before it written whole and nothing of
-            itself or after it (files are renamed into place once written).
-  --ply     also write the completed depth as a coloured point cloud (camera frame: x right, y down, z forward,
-            metres); needs the intrinsics of the RGB image. A folder when --rgb is one.
-  --uncertainty  also write the expected absolute error of the completed depth, metres:
-            X.npy float32 metres, or X.png a colour picture (dark blue 0 m to dark red >= --max-uncertainty, or
-            10 % of the model's max depth); a folder of <rgb stem>.npy when --rgb is one.
-  --max-uncertainty M  set the depth to 0 (no depth) where the expected error is above M metres, in --out and
-            in --ply; with no support (sky, above the top LiDAR beam) the expected error is the frame's highest.
-  --fill-all  write the dense map, depth also where no sample supports it (--max-uncertainty still applies).
-            Without it, those pixels are 0 (no depth) in --out and --ply: pixels more than one sample spacing s
-            above the highest sample of their column (sky, above the top LiDAR beam), and pixels farther than 3 s
-            from every sample (s = sqrt(area of the samples' bounding box / their number), pixels). --uncertainty
-            keeps every pixel.
-  --threads N  run on N CPU cores: every thread of the process (XLA's, OpenCV's, the frame readers') is pinned
-            to N of the cores it may use, as `taskset` does (Linux; OpenCV's threads only elsewhere). With this
-            JAX, XLA_FLAGS="--xla_cpu_multi_thread_eigen=false intra_op_parallelism_threads=N" does NOT limit
-            XLA's threads; `taskset -c 0,1 lipjax ...` works as well and picks the cores.
-
-Image size: any. A learned model runs at the working size where its samples lie about as far apart in pixels as
-in training, at most 60,000 pixels for LiDAR scan lines (sizes HxW: 200 points on 480x640 run at 196x261; a
-64-beam KITTI scan at 132x455; dense scattered samples at full size); a
-new size costs one compilation. Below full size the RGB is area-resized; each measured depth pixel is moved to the
-pixel of the small grid it falls in, keeping its value (the nearest one wins where several meet; depths are never
-averaged); the result is resized back (bilinear). At any size the measured pixels are then set to their measured
-values exactly.
-`--max-side N` overrides the working size: the longer side becomes at most N pixels. A learned model also runs the
-mirror image of LiDAR scan lines and averages the two (more accurate, twice the model's work, on the core the check
-leaves free); `--mirror` does so on every input, `--no-mirror` on none.
-With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
-every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
-`--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
-
-Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, ...)
-print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1 to see the traceback instead.
-A frame above 2 Mpixel run without --max-side gets a one-line hint.
-"""
-"""The inputs, outputs and options of `complete_files` in the words of `lipjax complete --help`, which shows it."""
 READ_WORKERS = 2
 """Threads that read and decode the next frames of a folder while the model runs."""
 MODEL_THREADS = 2
@@ -192,7 +136,10 @@ class Completed:
       outputs: the depth file of every frame, in order; plys: their point clouds (empty without ply).
       out: the `out` argument (a folder for folder inputs).
       seconds: wall-clock time of the whole call (reading, model loading and compilation, writing), seconds.
-      unsupported: share of all pixels set to 0 for want of support (0 with fill_all).
+      unsupported: share of all pixels set to 0 for want of support (blank_unsupported; else 0).
+      holes: share of all pixels the model or method gave no depth (0): written as 0, or given the nearest
+        pixel's depth with fill_all (`filled`).
+      method: the name of the model or method that ran.
       fitted_range_m: (0, top) metres of .color.png output fitted to the first frame; None when a range was
         given or the format is another.
     """
@@ -203,6 +150,9 @@ class Completed:
     seconds: float
     unsupported: float
     fitted_range_m: tuple[float, float] | None
+    holes: float = 0.0
+    filled: bool = False
+    method: str = ""
 
     def summary(self) -> str:
         """The line `lipjax complete` prints: what was written, frames/s for several frames, and notes."""
@@ -212,12 +162,31 @@ class Completed:
         else:
             wrote = f"{len(self.outputs)} frame(s) to {self.out} in {self.seconds:.1f} s"
             notes.append(f"{len(self.outputs) / self.seconds:.3g} frames/s")
+        if self.holes:
+            notes.append(f"{100 * self.holes:.1f} % of the pixels given the nearest depth (--fill-all)" if self.filled
+                         else f"{100 * self.holes:.1f} % of the pixels left at 0 by {self.method}"
+                         + ("" if self.unsupported else " (--fill-all fills them)"))
         if self.unsupported:
-            notes.append(f"{100 * self.unsupported:.1f} % of the pixels without support set to 0 (--fill-all keeps "
-                         "them)")
+            notes.append(f"{100 * self.unsupported:.1f} % of the pixels without support set to 0 "
+                         "(--blank-unsupported)")
         if self.fitted_range_m:
             notes.append(f"colours 0-{self.fitted_range_m[1]:.3g} m")
         return f"wrote {wrote}" + (f": {'; '.join(notes)}" if notes else "")
+
+
+def check_writable(flag: str, given: str | os.PathLike, folder: Path) -> None:
+    """Raises ValueError, one line naming `flag` and the folder, unless files can be written in `folder` (`given`:
+    the flag's value). A folder not there yet is made by the writers (lipjax.utils.written_whole), so the nearest
+    folder above it that is there must be writable. Run before any work: a read-only output folder would otherwise
+    fail only after the computation, naming a temporary file."""
+    there = Path(folder)
+    while not there.exists() and there != there.parent:
+        there = there.parent
+    if not there.is_dir():
+        raise ValueError(f"{flag} {given}: {there} is a file, not a folder; choose another {flag}")
+    if not os.access(there, os.W_OK | os.X_OK):
+        raise ValueError(f"{flag} {given}: cannot write in the folder {there} (read-only or no permission); choose "
+                         f"another {flag} or make the folder writable")
 
 
 def model_max_depth(completer: Any) -> float:
@@ -235,25 +204,33 @@ class _Output:
     png_scale: float
     color_range: tuple[float, float] | None
     fill_all: bool
+    blank_unsupported: bool
     max_uncertainty: float | None
     max_depth_m: float = SCENE_MAX_DEPTH_M["indoor"]
+    method: str = ""
     fitted: bool = False
     unsupported: int = 0
+    holes: int = 0
     pixels: int = 0
 
     def write(self, job: Job, rgb: np.ndarray, sparse: np.ndarray, dense: np.ndarray,
               intrinsics: Intrinsics | None) -> None:
-        """Applies --max-uncertainty and the support mask to one completed frame and writes its files."""
+        """Applies --fill-all, --max-uncertainty and --blank-unsupported to one completed frame, in the order
+        lipjax.methods.complete applies them, and writes its files."""
+        holes = dense <= 0
+        self.holes += int(np.count_nonzero(holes))
+        self.pixels += dense.size
+        if self.fill_all and holes.any():
+            dense = fill_holes(dense)
         if job.uncertainty or self.max_uncertainty is not None:
             u = expected_error(sparse, dense)
             if job.uncertainty:
                 write_uncertainty(job.uncertainty, u, self.max_uncertainty or 0.1 * self.max_depth_m)
             if self.max_uncertainty is not None:
                 dense = drop_uncertain(dense, u, self.max_uncertainty)
-        if not self.fill_all:
+        if self.blank_unsupported:
             unsupported = ~support_mask(sparse)
             self.unsupported += int(np.count_nonzero(unsupported & (dense > 0)))
-            self.pixels += dense.size
             dense = np.where(unsupported, np.float32(0), dense)
         if self.color_range is None:
             self.color_range, self.fitted = fitting_range(dense, self.max_depth_m), self.fmt == "color.png"
@@ -377,7 +354,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
                 first = completer is None
                 if first:
                     completer = _load(model, iterations, sparse, job.rgb, max_side, log)
-                    output.max_depth_m = model_max_depth(completer)
+                    output.max_depth_m, output.method = model_max_depth(completer), completer.name
                     threads = model_threads(completer)
                     bar = tqdm(total=len(plan.jobs), desc="lipjax complete", unit="frame", file=sys.stderr,
                                disable=not progress or len(plan.jobs) < 2)
@@ -403,8 +380,8 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
                    color_range: tuple[float, float] | None = None, ply: str | os.PathLike | None = None,
                    intrinsics: IntrinsicsLike | str | os.PathLike | None = None,
                    uncertainty: str | os.PathLike | None = None, max_uncertainty: float | None = None,
-                   fill_all: bool = False, progress: bool = True, log: Callable[[str], None] | None = None,
-                   workers: int = READ_WORKERS) -> Completed:
+                   fill_all: bool = False, blank_unsupported: bool = False, progress: bool = True,
+                   log: Callable[[str], None] | None = None, workers: int = READ_WORKERS) -> Completed:
     """Completes the sparse depth of one frame or of a folder of frames and writes the results.
 
     Args:
@@ -422,14 +399,20 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
         gives them otherwise).
       uncertainty, max_uncertainty: also write the expected absolute error (metres); depth 0 where it is above
         max_uncertainty metres.
-      fill_all: keep the depth of pixels without support (lipjax.uncertainty.support_mask); by default 0 there.
+      fill_all: depth at every pixel: the 0s the model or method leaves get the nearest pixel's depth
+        (lipjax.classical.fill_holes). blank_unsupported: 0 where no sample supports the depth
+        (lipjax.uncertainty.support_mask). Neither (the default): the depth as lipjax.complete returns it.
       progress: a progress bar on stderr for several frames. log: receives the line naming the default model.
       workers: threads reading the next frames of a folder while the model runs.
 
     Returns Completed (its `summary()` is the line the command prints). Raises ValueError / OSError with a
-    one-line message for anything the user can fix.
+    one-line message for anything the user can fix, before any frame is read when it can (an output folder that
+    cannot be written, contradicting flags, ...).
     """
     start = time.perf_counter()
+    if fill_all and blank_unsupported:
+        raise ValueError("--fill-all (depth at every pixel) and --blank-unsupported (0 where no sample supports it) "
+                         "contradict each other; pass one of them")
     if (depth is None) == (lidar is None):
         raise ValueError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
     if (lidar is None) != (calib is None):
@@ -445,22 +428,67 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
         raise ValueError(f"--color-range {color_range[0]:g} {color_range[1]:g}: MAX_M must be > MIN_M")
     plan = plan_jobs(rgb, depth if lidar is None else lidar, out, ply=ply, uncertainty=uncertainty,
                      out_format=out_format)
+    for flag, given in (("--out", out), ("--ply", ply), ("--uncertainty", uncertainty)):  # before any work
+        paths = [getattr(j, flag.lstrip("-")) for j in plan.jobs]  # Job.out, .ply, .uncertainty
+        for folder in {p.parent for p in paths if p is not None}:
+            check_writable(flag, given, folder)
     if depth_scale and plan.metres_in and plan.fmt != "png":
         warnings.warn(f"--depth-scale {depth_scale:g} is ignored: {'the sweep is' if lidar else '.npy depth is'} "
                       "metres, never scaled (--depth-scale applies to .png depth, in and out)", stacklevel=2)
 
     def read(job: Job) -> tuple[Job, np.ndarray, np.ndarray, Intrinsics | None]:
         if lidar is None:
-            return (job, *read_frame(job.rgb, job.depth, depth_scale), intrinsics)
+            return (job, *read_depth_frame(job.rgb, job.depth, depth_scale), intrinsics)
         frame_rgb, sparse, calibrated = read_lidar_frame(job.rgb, job.depth, calib, camera)
         return job, frame_rgb, sparse, intrinsics or calibrated
 
     output = _Output(plan.fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, tuple(color_range) if color_range else None,
-                     fill_all, max_uncertainty)
+                     fill_all, blank_unsupported, max_uncertainty)
     _run(plan, read, output, model, iterations, max_side, mirror, cross_check, progress, log, workers)
+    pixels = output.pixels or 1
     return Completed([j.out for j in plan.jobs], [j.ply for j in plan.jobs if j.ply], Path(out),
-                     time.perf_counter() - start, output.unsupported / output.pixels if output.pixels else 0.0,
-                     output.color_range if output.fitted else None)
+                     time.perf_counter() - start, output.unsupported / pixels,
+                     output.color_range if output.fitted else None, output.holes / pixels, fill_all, output.method)
+
+
+def check_npy_depth_dtype(path: str | os.PathLike) -> None:
+    """A one-line ValueError when a depth .npy holds integers: depth .npy is float metres, and integers are another
+    unit (millimetres, centimetres: the likely one named, lipjax.inputs.likely_units) or metres cut to whole
+    numbers (a median within the depth of real scenes). Files numpy cannot read are left to the reader's error."""
+    try:
+        raw = np.load(path, mmap_mode="r", allow_pickle=False)
+    except Exception:  # noqa: BLE001 - lipjax.data.folder.read_depth names what is wrong with the file
+        return
+    if not np.issubdtype(raw.dtype, np.integer):
+        return
+    depth = np.asarray(raw, np.float64)
+    depth = depth[..., 0] if depth.ndim == 3 and depth.shape[-1] == 1 else depth
+    samples = depth[depth > 0]
+    median = float(np.median(samples)) if samples.size else 0.0
+    head = f"{path}: depth .npy holds {raw.dtype} (integer) values (median {median:.0f}), not float metres"
+    if median <= SCENE_MEDIAN_M["outdoor"][1]:
+        raise ValueError(f"{head}: metres cut to whole numbers? save the depth as float32 metres before any cast to "
+                         "an integer type")
+    lidar = depth.ndim == 2 and is_lidar_pattern(depth)
+    units = likely_units(samples, lidar)
+    per_metre = units[0][1] if units else "units_per_metre"
+    raise ValueError(f"{head} ({unit_hint(samples, lidar)}): save it as float32 metres, e.g. "
+                     f"depth.astype(np.float32) / {per_metre}")
+
+
+def read_depth_frame(rgb_path: str | os.PathLike, depth_path: str | os.PathLike,
+                     scale: float | None) -> tuple[np.ndarray, np.ndarray]:
+    """lipjax.data.folder.read_frame (rgb (H, W, 3) uint8, sparse (H, W) float32 metres) with the checks of the depth
+    file's numbers that `lipjax complete` makes: a .npy of integers is an error (`check_npy_depth_dtype`); a PNG
+    whose --depth-scale puts many samples beyond every model's range warns, naming the scale that fits
+    (lipjax.inputs.check_depth_scale)."""
+    suffix = Path(depth_path).suffix.lower()
+    if suffix == ".npy":
+        check_npy_depth_dtype(depth_path)
+    rgb, sparse = read_frame(rgb_path, depth_path, scale)
+    if suffix == ".png":
+        check_depth_scale(sparse, scale)
+    return rgb, sparse
 
 
 @dataclasses.dataclass(frozen=True)
@@ -487,6 +515,8 @@ def project_file(rgb: str | os.PathLike, lidar: str | os.PathLike, calib: str | 
     depth to `out` (.npy metres, .png 16-bit at depth_scale or 256 per metre, .color.png a picture from 0 to its
     farthest point)."""
     fmt = output_format(out)
-    sparse, _, counts = project_sweep(lidar, calib, read_rgb(rgb).shape[:2], camera, return_counts=True)
+    check_writable("--out", out, Path(out).parent)
+    sparse, _, counts = project_sweep(lidar, calib, read_rgb(rgb).shape[:2], camera, return_counts=True,
+                                      image_path=rgb)
     write_depth(out, sparse, fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, (0.0, float(sparse.max())))
     return Projected(Path(out), sparse, counts)

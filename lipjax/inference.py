@@ -68,8 +68,8 @@ class Completer:
 
         `lipjax.complete(rgb, sparse, model=completer)` is the default path instead (`complete_frame`): the model at
         the working size of the samples (lipjax.resolution), every measured pixel set back. On 200 points on 480x640
-        synthetic rooms the two differ a lot: lip-any is 0.95x a linear fill at full size and 0.82x at the working
-        size (benchmarks/working_resolution.py, the README's "Any resolution")."""
+        synthetic rooms the two differ a lot: lip-any is 0.95x a linear fill at full size and 0.82x at the working size
+        (`python -m benchmarks.working_resolution`; docs/decisions/0001-working-resolution.md)."""
         rgb, sparse, batched = check_inputs(rgb, sparse, self.config.max_depth_m, self.name, self.scan_lines_trained,
                                              self.both_scenes)
         depth, _ = compiled_apply(self.config, False)(self.params, rgb, sparse, self.config.host_inputs(sparse))
@@ -94,12 +94,22 @@ class Completer:
 
     @functools.cached_property  # read on every call: the spec is parsed once
     def scan_lines_trained(self) -> bool:
-        """Whether the model's training input included LiDAR scan lines (its metadata's `train_sampler`, a
-        lipjax.data.sampling spec, recorded at export; older models record none)."""
+        """Whether the model's training input may have included LiDAR scan lines (its metadata's `train_sampler`,
+        recorded at export; older models record none), so that lipjax.inputs does not warn about scan lines.
+
+        A lipjax.data.sampling spec says so (`draws_scan_lines`). "input" / "input:N", the training data's own sparse
+        input (a folder's sparse/ maps, KITTI's scans), says True: its pattern, unknown here, is the user's sensor's,
+        which the model was trained on, so the same sensor's scan lines are no warning. So is a spec this version
+        cannot read (a sampler of a later version): the model loads and runs, with no warning about the pattern."""
         from lipjax.data.sampling import draws_scan_lines
 
         spec = self.metadata.get("train_sampler")
-        return spec is not None and draws_scan_lines(spec)
+        if spec is None:
+            return False
+        try:
+            return draws_scan_lines(spec)
+        except ValueError:
+            return True
 
 
 def load_model(name_or_path: str | os.PathLike = DEFAULT_MODEL) -> Completer:
@@ -123,10 +133,10 @@ def default_model(scene: str = "indoor") -> Completer:
 # Whether the default path (`complete_at`, `lipjax.complete`, `lipjax complete`, the ONNX graph) averages a learned
 # model's estimate with that of the mirror-image frame (`mirror_averaged`) where the caller does not say
 # (mirror=None): on LiDAR scan lines, where the check against the linear fill (lipjax.crosscheck) does not run and
-# leaves the second core free (rule 54 of docs/design-notes.md: the 1,260,640-image lip-any's synthetic suite 0.6350
-# -> 0.6323 x linear, streets with HDL-64 0.404 -> 0.391; the 352x1216 street in two threads 37 -> 42 ms). Not on
-# scattered samples: there the check's held-out fold takes that core (480x640 with 200 points 36 -> 61 ms with both).
-# `mirror=True` / `--mirror` asks for it on any input, `mirror=False` / `--no-mirror` nowhere.
+# leaves the second core free (docs/decisions/0020-flip-averaging-on-scan-lines.md: the 1,260,640-image lip-any's
+# synthetic suite 0.6350 -> 0.6323 x linear, streets with HDL-64 0.404 -> 0.391; the 352x1216 street in two threads 37
+# -> 42 ms). Not on scattered samples: there the check's held-out fold takes that core (480x640 with 200 points 36 ->
+# 61 ms with both). `mirror=True` / `--mirror` asks for it on any input, `mirror=False` / `--no-mirror` nowhere.
 MIRROR_SCAN_LINES = True
 # Threads that run the mirror image's estimate beside the frame's (`mirror_averaged`, on the CPU): a pool of its own,
 # as a held-out fold running in lipjax.crosscheck's threads asks for one (its tasks wait on nothing, so a full pool
@@ -134,21 +144,21 @@ MIRROR_SCAN_LINES = True
 _MIRROR_BESIDE = ThreadPoolExecutor(max_workers=crosscheck.FOLDS + 1, thread_name_prefix="lipjax-mirror")
 
 # Whether the default path checks a learned model against the linear fill on held-out samples and leans on the
-# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by rules
-# on synthetic frames (docs/design-notes.md, "A check against the linear fill", rules 52-53). Off (`cross_check=False`,
-# `lipjax complete --no-cross-check`): the model's estimate alone, run once instead of twice (six times where the
-# first held-out fold goes against the model) on scattered samples (480x640 with 200 points, training paused: 36 ms
-# checked, the held-out run in a second thread at the kept samples' own working size, rule 48, against 26 ms); what
-# the ONNX graph computes.
+# fill where the model is the worse of the two (`lipjax.crosscheck`; scattered samples only). On: chosen by rules on
+# synthetic frames (docs/decisions/0013-cross-check-against-the-linear-fill.md and 0015-cross-check-by-folds.md). Off
+# (`cross_check=False`, `lipjax complete --no-cross-check`): the model's estimate alone, run once instead of twice (six
+# times where the first held-out fold goes against the model) on scattered samples (480x640 with 200 points, training
+# paused: 36 ms checked, the held-out run in a second thread at the kept samples' own working size
+# (docs/decisions/0014-held-out-run-size.md), against 26 ms); what the ONNX graph computes.
 CROSS_CHECK = True
 
 # Whether the default path (`complete_at`, the ONNX graph) spreads the samples' residuals over the frame after
-# resizing a working-size estimate back to full size (`lipjax.spread`). On: chosen by rule 46 (docs/design-notes.md)
-# with the 724,000-image lip-any: `benchmarks/generalisation.py --frames 8 --no-cross-check` 0.708148 -> 0.706272
-# (streets HDL-64 0.428 -> 0.421, VLP-32 0.806 -> 0.798, no setting worse) and 24 synthetic streets with HDL-64
-# scored where KITTI's ground truth would lie (`benchmarks/kitti_like_gt.py`) 1.114 -> 1.028 x linear; scan lines
-# with sigmas of their own since rule 47 (772,000-image lip-any: suite 0.696992 -> 0.696054, those streets 1.024 ->
-# 0.991 x linear).
+# resizing a working-size estimate back to full size (`lipjax.spread`). On: docs/decisions/0018-residual-spreading.md,
+# with the 724,000-image lip-any: `python -m benchmarks.generalisation --frames 8 --no-cross-check` 0.708148 ->
+# 0.706272 (streets HDL-64 0.428 -> 0.421, VLP-32 0.806 -> 0.798, no setting worse) and 24 synthetic streets with
+# HDL-64 scored where KITTI's ground truth would lie (`python -m benchmarks.kitti_like_gt`) 1.114 -> 1.028 x linear;
+# scan lines with sigmas of their own (docs/decisions/0019-scan-line-sigmas.md; 772,000-image lip-any: suite 0.696992
+# -> 0.696054, those streets 1.024 -> 0.991 x linear).
 SPREAD_RESIDUALS = True
 
 # A frame above this many pixels runs slowly and needs gigabytes at full size: callers suggest max_side.
@@ -207,8 +217,9 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
 @dataclasses.dataclass(frozen=True)
 class AtWorkingSize:
     """`completer` run one frame at a time as `lipjax.complete` runs it (`complete_frame`: a learned model at the
-    working size of the samples, every measured pixel set back), named as `completer`: for scoring the default path
-    (`lipjax evaluate --working-size`) rather than the model at the input's size."""
+    working size of the samples, every measured pixel set back; a hand-crafted method as it is), named as
+    `completer`: for scoring the default path (`lipjax evaluate --working-size`) rather than the model at the
+    input's size."""
 
     completer: Any
 
@@ -249,10 +260,12 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
 
     Below full size the RGB is area-resized, the samples move onto the small grid (`reproject_sparse`), and the
     estimate z (h, w) is resized back (bilinear) and, with `spread` (SPREAD_RESIDUALS), the samples' residuals
-    y - z are spread over it (`lipjax.spread`; scan lines get their own sigmas). Then, at any size, the final
-    x-update runs at full size: with rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho) sets
-    every measured pixel back to its measured value (the model's own last x-update, with its learned rho, keeps
-    them only approximately).
+    y - z are spread over it (`lipjax.spread`; scan lines get their own sigmas). Then, for a learned model at any
+    size, the final x-update runs at full size: with rho -> 0 at the measured pixels (m = 1),
+    x = (m y + rho z) / (m + rho) sets every measured pixel back to its measured value (the model's own last
+    x-update, with its learned rho, keeps them only approximately); likewise for any completer run below full size.
+    Any other completer at full size (the hand-crafted methods, lipjax.methods.CLASSICAL) is returned as it
+    returns: IP-Basic, as published, replaces background returns seen through gaps in the foreground.
     With `mirror` a learned model's estimate is `mirror_averaged`; None (the default) does so on LiDAR scan lines
     (`mirrors`; MIRROR_SCAN_LINES says why). With `cross_check` (CROSS_CHECK) a learned model's estimate of
     scattered samples is checked against the linear fill on held-out samples and blended with it where it is the
@@ -288,6 +301,7 @@ def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[in
         dense, _ = crosscheck.cross_checked(estimate, sparse_m, (h, w), scan_lines=lines)
     else:
         dense = estimate(sparse_m, (h, w))
-    measured = sparse_m > 0
-    dense[measured] = sparse_m[measured]
+    if isinstance(completer, Completer) or (h, w) != (big_h, big_w):  # a hand-crafted method at full size: as is
+        measured = sparse_m > 0
+        dense[measured] = sparse_m[measured]
     return dense

@@ -11,8 +11,8 @@ Sparse depth is float metres with 0 = no sample. A unit mistake that is near cer
 only probable, or data unlike what the model was trained on, gives a one-line `warnings.warn` naming the likely
 cause (the same text for every frame, so a folder of frames warns once):
 
-    median sample depth > 1000 m                          error: not metres (millimetres?)
-    median > 10x the model's range (10 m / 85 m)          error: centimetres or millimetres for this model
+    median sample depth > 1000 m                          error: not metres (the likely unit: `unit_hint`)
+    median > 10x the model's range (10 m / 85 m)          error: not metres (the likely unit) for this model
     indoor model, a quarter of the samples beyond 10 m    warning: outdoor data (scan lines, or samples beyond
                                                           39 m): use the outdoor model; else a millimetre (Kinect)
                                                           PNG read with --depth-scale 256, or outdoor data
@@ -22,6 +22,8 @@ cause (the same text for every frame, so a folder of frames warns once):
     outdoor model, all within 10 m, no scan lines         warning: looks like indoor data
     outdoor model, a dense map within 39 m                warning: a millimetre PNG read with --depth-scale 256?
     samples 4x sparser than the sparsest training input   warning: expect larger errors
+    a depth PNG's scale puts over 5 % beyond 85 m         warning: the known scale that fits (`check_depth_scale`,
+                                                          called by the file readers, which know the scale)
 """
 from __future__ import annotations
 
@@ -48,6 +50,18 @@ OUTDOOR_MEDIAN_M = 12.0
 TRAINED_MIN_DENSITY = {"indoor": 100 / (256 * 320), "outdoor": 200 / (128 * 416)}
 # Indoor depth (<= 10 m) stored in millimetres but read with --depth-scale 256 reaches at most this.
 KINECT_AT_256_M = INDOOR_DEPTH_M * KNOWN_DEPTH_SCALES["nyu"] / KNOWN_DEPTH_SCALES["kitti"]
+# Median sample depth of real scenes with a margin, metres: rooms (Kinect, NYU: 1-5 m) and streets (a car's LiDAR:
+# about 10-20 m). A unit that puts a median in its scene's range is a likely unit; `unit_hint` names it.
+SCENE_MEDIAN_M = {"indoor": (0.5, 8.0), "outdoor": (3.0, 60.0)}
+TYPICAL_MEDIAN_M = {"indoor": 2.5, "outdoor": 15.0}  # the unit nearest to it (in ratio) is named first
+UNITS_PER_METRE = {"millimetres": 1000, "centimetres": 100}
+# The deepest depth any model here completes (the outdoor models' range): nearly all of a street's samples lie within.
+PNG_DEPTH_LIMIT_M = max(SCENE_MAX_DEPTH_M.values())
+# A PNG scale that puts more than this share of the samples beyond PNG_DEPTH_LIMIT_M is wrong (`check_depth_scale`).
+BEYOND_LIMIT_SHARE = 0.05
+# What a PNG at each known scale holds, for the warning that names the scale that fits.
+SCALE_UNITS = {KNOWN_DEPTH_SCALES["kitti"]: "KITTI's 256 per metre", KNOWN_DEPTH_SCALES["nyu"]: "millimetres",
+               KNOWN_DEPTH_SCALES["tum"]: "TUM's 5000 per metre"}
 
 
 class InputError(ValueError):
@@ -91,7 +105,7 @@ def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "thi
         raise InputError(f"sparse depth is empty: no samples (all zeros) in image(s) {empty}; nothing to complete")
     median = float(np.median(sparse[sparse > 0]))
     if median > MAX_PLAUSIBLE_DEPTH_M:
-        raise InputError(f"sparse depth has a median of {median:.0f}: not metres (millimetres? divide by 1000)")
+        raise InputError(f"sparse depth has a median of {median:.0f}: not metres ({unit_hint_of(sparse)})")
     if max_depth_m is not None:
         check_for_model(sparse, max_depth_m, name, scan_lines_trained, both_scenes)
     if np.issubdtype(rgb.dtype, np.floating):
@@ -148,6 +162,60 @@ def scene_reason(sparse: np.ndarray) -> tuple[str, str]:
     return "indoor", f"scattered samples, median depth {median:.1f} m"
 
 
+def likely_units(samples: np.ndarray, lidar: bool) -> list[tuple[str, int]]:
+    """The units ("millimetres", 1000) or ("centimetres", 100) that depth samples (> 0) given as metres but far too
+    large are likely in, the likelier first; none when neither fits.
+
+    A unit fits when it puts the samples' median in the range of median depths of real scenes (SCENE_MEDIAN_M):
+    streets for samples in LiDAR scan lines (`lidar`); else rooms, then streets (scattered samples are mostly a
+    depth camera's, in millimetres). Of two that fit, the one nearer (in ratio) the scene's TYPICAL_MEDIAN_M comes
+    first: a median of 3000 in scan lines is 30 m in centimetres (a street) before 3 m in millimetres; scattered,
+    it is 3 m in millimetres (a room), and 30 m fits no room. (Raw KITTI PNG values, 256 per metre, are not
+    inferred: they read as centimetres.)"""
+    median = float(np.median(samples))
+    for scene in ("outdoor",) if lidar else ("indoor", "outdoor"):
+        low, high = SCENE_MEDIAN_M[scene]
+        fits = sorted((abs(np.log(median / per_metre / TYPICAL_MEDIAN_M[scene])), unit, per_metre)
+                      for unit, per_metre in UNITS_PER_METRE.items() if low <= median / per_metre <= high)
+        if fits:
+            return [(unit, per_metre) for _, unit, per_metre in fits]
+    return []
+
+
+def unit_hint(samples: np.ndarray, lidar: bool) -> str:
+    """`likely_units` as a hint: "centimetres? divide by 100", "millimetres? divide by 1000", both ("millimetres?
+    divide by 1000; centimetres? by 100"), or, when neither fits, the rule."""
+    units = likely_units(samples, lidar)
+    if not units:
+        return "divide by its units per metre: 100 for centimetres, 1000 for millimetres"
+    return "; ".join(f"{unit}? {'divide by' if i == 0 else 'by'} {per_metre}"
+                     for i, (unit, per_metre) in enumerate(units))
+
+
+def unit_hint_of(sparse: np.ndarray) -> str:
+    """`unit_hint` of a (H, W) or (B, H, W) sparse map, scan lines or not judged from its frames."""
+    sparse = np.asarray(sparse)
+    lidar = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
+    return unit_hint(sparse[sparse > 0], lidar)
+
+
+def check_depth_scale(depth_m: np.ndarray, scale: float) -> None:
+    """Warns (one line, the same for every frame) when a PNG depth map read at `scale` (value per metre, the
+    --depth-scale) puts more than BEYOND_LIMIT_SHARE of its samples beyond PNG_DEPTH_LIMIT_M, naming the known
+    scale (KNOWN_DEPTH_SCALES) that would put them within it: e.g. a millimetre PNG read at 256 (KITTI's) reaches
+    3.9x its depth, 300 m for a street. A scale too large (depth too near) is not judged: no depth is too near."""
+    samples = np.asarray(depth_m)[np.asarray(depth_m) > 0]
+    if samples.size == 0 or np.mean(samples > PNG_DEPTH_LIMIT_M) <= BEYOND_LIMIT_SHARE:
+        return
+    raw = samples.astype(np.float64) * scale
+    fitting = [s for s in sorted(SCALE_UNITS)
+               if s > scale and np.mean(raw / s > PNG_DEPTH_LIMIT_M) <= BEYOND_LIMIT_SHARE]
+    fix = (f"{SCALE_UNITS[fitting[0]]}? --depth-scale {fitting[0]:g} fits it" if fitting
+           else "give the PNG's value per metre as --depth-scale")
+    _warn(f"depth PNG read with --depth-scale {scale:g} puts over {100 * BEYOND_LIMIT_SHARE:g} % of its samples "
+          f"beyond {PNG_DEPTH_LIMIT_M:g} m, the deepest range of any model: {fix}")
+
+
 def _other_model(name: str, scene: str) -> str:
     """The shipped model of `scene` named like `name` (lip-cnn-indoor -> lip-cnn-outdoor), else the default."""
     other = {"indoor": "outdoor", "outdoor": "indoor"}[scene]
@@ -169,7 +237,7 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
     median = float(np.median(samples))
     if median > 10 * max_depth_m:
         raise InputError(f"sparse depth has a median of {median:.0f} m, over 10x the {max_depth_m:g} m range of "
-                         f"{name}: not metres (centimetres? divide by 100; millimetres? by 1000)")
+                         f"{name}: not metres ({unit_hint_of(sparse)})")
     indoor = max_depth_m <= INDOOR_DEPTH_M
     lidar = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
     density = samples.size / sparse.size

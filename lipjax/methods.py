@@ -9,10 +9,13 @@ lipjax.classical), and nothing it builds imports it.
                                        arguments override the method's settings
     get_completer(None, sparse=s)      the shipped default model of the scene the samples suggest
     get_completer(obj)                 a completer object, returned as is
+    listing()                          what `lipjax models` prints: the shipped models, then the hand-crafted ones
 
 All are `DepthCompleter`s: completer(rgb (H,W,3) uint8, sparse (H,W) float32 metres) -> (H,W) float32 m, with
 a `name`. Learned models are `lipjax.inference.Completer`s over a `lipjax.interfaces.LearnedModel` (model types by
-name: `lipjax.interfaces.MODEL_TYPES`, the table model files use). `complete` is the one-call front end.
+name: `lipjax.interfaces.MODEL_TYPES`, the table model files use). `complete` is the one-call front end, with the
+default `lipjax complete` has too: the depth as the model or method returns it (`fill_all` fills the 0s a method
+leaves, `blank_unsupported` sets 0 where no sample supports the depth).
 """
 from __future__ import annotations
 
@@ -30,6 +33,7 @@ from lipjax.classical import (
     IPBasicMultiscaleFill,
     LinearFill,
     NearestFill,
+    fill_holes,
 )
 from lipjax.interfaces import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
@@ -37,7 +41,7 @@ from lipjax.inference import CROSS_CHECK, Completer, complete_frame, default_mod
 from lipjax.inputs import suggest_scene
 from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
-from lipjax.uncertainty import drop_uncertain, expected_error
+from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported
 
 # Methods without learned parameters, by name: their factories take the method's settings as keyword arguments.
 CLASSICAL: dict[str, Callable[..., DepthCompleter]] = {
@@ -48,6 +52,16 @@ CLASSICAL: dict[str, Callable[..., DepthCompleter]] = {
     "ip_basic_adaptive": IPBasicAdaptiveFill,
     "colorization": ColorizationFill,
     "lip-wavelet": LIPWavelet,
+}
+# What each is, in the words of `lipjax models`.
+CLASSICAL_SUMMARY = {
+    "nearest": "the nearest sample's depth (Voronoi cells)",
+    "linear": "Delaunay piecewise-linear; the nearest sample's outside the samples' hull",
+    "ip_basic": "IP-Basic fill_in_fast (Ku et al. 2018) as published; 0 out of reach of its dilations",
+    "ip_basic_multiscale": "IP-Basic fill_in_multiscale as published; 0 out of reach of its dilations",
+    "ip_basic_adaptive": "IP-Basic with kernels sized to the samples' density; depth everywhere",
+    "colorization": "Levin et al. 2004 colourisation, guided by the RGB image",
+    "lip-wavelet": "the LIP solver with a wavelet soft-thresholding prox in place of the learned one",
 }
 
 
@@ -86,18 +100,28 @@ def available_methods(scene: str) -> list[str]:
     return learned + list(CLASSICAL)
 
 
-def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_uncertainty: float | None = None,
-             return_uncertainty: bool = False, mirror: bool | None = None, cross_check: bool = CROSS_CHECK):
+def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, fill_all: bool = False,
+             blank_unsupported: bool = False, max_uncertainty: float | None = None, return_uncertainty: bool = False,
+             mirror: bool | None = None, cross_check: bool = CROSS_CHECK):
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
     `model`: anything `get_completer` takes; by default the shipped default model, indoor or outdoor as the samples
-    suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`);
-    `mirror` also runs it on the mirror-image frame and averages (more accurate, twice the model's work; None: on
-    LiDAR scan lines, lipjax.inference.mirrors); `cross_check` checks it against the linear fill on held-out
-    samples (lipjax.crosscheck; CROSS_CHECK). With `max_uncertainty` (metres), depth is 0 (none) where the
-    expected absolute error (`lipjax.uncertainty.expected_error`) is above it; `return_uncertainty` returns
-    (depth, expected error m).
+    suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`),
+    every measured pixel set back; a hand-crafted method (CLASSICAL) returns exactly what it returns itself, as
+    published (IP-Basic leaves 0 out of reach of its dilations). `mirror` also runs a learned model on the
+    mirror-image frame and averages (more accurate, twice the model's work; None: on LiDAR scan lines,
+    lipjax.inference.mirrors); `cross_check` checks it against the linear fill on held-out samples
+    (lipjax.crosscheck; CROSS_CHECK).
+    By default the depth is the model's or method's, at every pixel it gives depth, as `lipjax complete` writes it.
+    `fill_all`: depth at every pixel, the 0s left filled with the nearest pixel's depth
+    (`lipjax.classical.fill_holes`; --fill-all). `blank_unsupported`: 0 where no sample supports the depth
+    (`lipjax.uncertainty.mask_unsupported`; --blank-unsupported); not with `fill_all`. With `max_uncertainty`
+    (metres), depth is 0 (none) where the expected absolute error (`lipjax.uncertainty.expected_error`) is above
+    it; `return_uncertainty` returns (depth, expected error m), the error of every pixel.
     """
+    if fill_all and blank_unsupported:
+        raise ValueError("fill_all (depth at every pixel) and blank_unsupported (0 where no sample supports it) "
+                         "contradict each other; pass one of them")
     completer = get_completer(model, sparse=sparse)
     rgb, sparse = np.asarray(rgb), np.asarray(sparse)
     if sparse.ndim == 3:
@@ -105,9 +129,20 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, max_unce
                           for c, y in zip(rgb, sparse)])
     else:
         dense = complete_frame(completer, rgb, sparse, mirror=mirror, cross_check=cross_check)
-    if max_uncertainty is None and not return_uncertainty:
-        return dense
-    u = expected_error(sparse, dense)
+    if fill_all:
+        dense = fill_holes(dense)
+    u = expected_error(sparse, dense) if max_uncertainty is not None or return_uncertainty else None
     if max_uncertainty is not None:
         dense = drop_uncertain(dense, u, max_uncertainty)
+    if blank_unsupported:
+        dense = mask_unsupported(dense, sparse)
     return (dense, u) if return_uncertainty else dense
+
+
+def listing() -> str:
+    """What `lipjax models` prints: the shipped models (`lipjax.model_io.listing`), then the hand-crafted methods
+    that --model also takes (CLASSICAL: no weights, nothing to ship)."""
+    width = max(map(len, CLASSICAL))
+    rows = [f"{name:<{width}}  {CLASSICAL_SUMMARY[name]}" for name in CLASSICAL]
+    return (model_io.listing() + "\n\nHAND-CRAFTED (no weights, no training; --model NAME runs each as the method "
+            "returns it):\n" + "\n".join(rows))

@@ -30,17 +30,18 @@ than the one lipjax trains with, see that module):
      `lipjax.complete(rgb, sparse, model=nearest_twin(model), cross_check=False)`. "auto" picks nearest for LiDAR
      scan lines, so for scan lines such a model's export equals lipjax.complete; for scattered points it differs
      from its linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m
-     in the graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room
-     (benchmarks/onnx_check.py --scattered). The shipped outdoor models use "nearest": their export equals
-     lipjax.complete on scan lines and, with cross_check=False, on any input (KITTI, 352x1216, HDL-64: median
-     |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
+     in the graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room (`python -m
+     benchmarks.onnx_check --scattered`). The shipped outdoor models use "nearest": their export equals lipjax.complete
+     on scan lines and, with cross_check=False, on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm,
+     99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
      (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured
      pixels set back to their measured values. For LiDAR scan lines (and with `mirror=True`, `lipjax export
      --mirror`, for scattered samples) the frames and their mirror images run as one batch of 2B, and each frame's
-     two estimates are averaged after flipping the second back, as `lipjax.complete` does on scan lines (rule 54
-     of docs/design-notes.md; `--no-mirror` leaves it out, at half the model's work).
+     two estimates are averaged after flipping the second back, as `lipjax.complete` does on scan lines (flip
+     averaging, docs/decisions/0020-flip-averaging-on-scan-lines.md; `--no-mirror` leaves it out, at half the model's
+     work).
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
 of the model against the linear fill on held-out samples (lipjax.crosscheck; scattered samples only) is not in the
 graph (it needs the Delaunay fill): the graph is `lipjax.complete(..., cross_check=False)`. No input

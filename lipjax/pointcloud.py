@@ -196,15 +196,12 @@ def read_point_cloud(path: str | os.PathLike) -> np.ndarray:
     """(N, 3) float32 x, y, z (metres, in the sensor's frame) of a point cloud file: a KITTI .bin (float32 x, y,
     z, reflectance per point), a .npy (N, >=3) array whose first three columns are x, y, z, or a PCD file
     (DATA ascii or binary, fields x y z). Other columns are dropped; non-finite points are kept (the projection
-    drops them). Raises ValueError naming the file and the problem."""
+    drops them). Raises ValueError naming the file and the problem; for a .bin in another layout (float64, 3 or 5
+    columns, millimetres: `_read_bin`), naming that layout and how to save the file as a .npy."""
     path = pathlib.Path(path)
     suffix = path.suffix.lower()
     if suffix == ".bin":
-        raw = np.fromfile(path, dtype=np.float32)
-        if raw.size % 4:
-            raise ValueError(f"{path}: a KITTI .bin sweep holds 4 float32 per point (x y z reflectance); its size "
-                             f"({raw.size * 4} bytes) is not a multiple of 16: corrupt, or another format")
-        return raw.reshape(-1, 4)[:, :3]
+        return _read_bin(path)
     if suffix == ".npy":
         try:
             points = np.load(path, allow_pickle=False)
@@ -217,6 +214,75 @@ def read_point_cloud(path: str | os.PathLike) -> np.ndarray:
     if suffix == ".pcd":
         return _read_pcd(path)
     raise ValueError(f"{path}: unknown point cloud format {suffix!r}; use {POINT_CLOUD_FORMATS}")
+
+
+# No LiDAR measures a kilometre: coordinates beyond it are the bytes of another layout read as KITTI's.
+MAX_POINT_RANGE_M = 1000.0
+# A layout fits a .bin when at least this share of its points is plausible (a sweep may hold a few odd returns).
+PLAUSIBLE_SHARE = 0.99
+# Layouts a .bin is checked against when KITTI's (float32 x y z reflectance) does not fit it: (dtype, columns, what),
+# more columns first (a file read with fewer columns than it has still looks like points; with more, it does not).
+OTHER_BIN_LAYOUTS = (("float64", 4, "x y z reflectance"), ("float64", 3, "x y z"),
+                     ("float32", 5, "x y z intensity ring, as nuScenes"), ("float32", 3, "x y z"))
+
+
+def _plausible_share(table: np.ndarray) -> float:
+    """The share of the rows of an (N, >=3) table read from a .bin that are points: x y z within
+    MAX_POINT_RANGE_M, any further columns (reflectance, intensity, ring) finite and >= 0. Rows whose x y z are
+    not all finite (no return) are left out; 0 when no row is left."""
+    xyz = table[:, :3].astype(np.float64)
+    finite = np.isfinite(xyz).all(axis=1)
+    if not finite.any():
+        return 0.0
+    ok = (np.abs(xyz[finite]) <= MAX_POINT_RANGE_M).all(axis=1)
+    if table.shape[1] > 3:
+        extra = table[finite, 3:].astype(np.float64)
+        with np.errstate(invalid="ignore"):
+            ok &= (np.isfinite(extra) & (extra >= 0)).all(axis=1)
+    return float(ok.mean())
+
+
+def _bin_table(blob: bytes, dtype: str, columns: int) -> np.ndarray | None:
+    """The (N, columns) table of a .bin's bytes read as `dtype`, or None when its size does not divide."""
+    size = np.dtype(dtype).itemsize * columns
+    if not blob or len(blob) % size:
+        return None
+    return np.frombuffer(blob, dtype="<" + np.dtype(dtype).str[1:]).reshape(-1, columns)
+
+
+def _read_bin(path: pathlib.Path) -> np.ndarray:
+    """x, y, z of a KITTI .bin (float32 x y z reflectance per point, 16 bytes). A file that is not in that layout
+    but in another one (float64, 3 or 5 columns: OTHER_BIN_LAYOUTS, each judged by `_plausible_share`) is a
+    one-line error naming that layout and how to save it as a .npy, which records its layout itself."""
+    blob = path.read_bytes()
+    kitti = _bin_table(blob, "float32", 4)
+    if kitti is not None and _plausible_share(kitti) >= PLAUSIBLE_SHARE:
+        return np.array(kitti[:, :3])
+    for dtype, columns, what in OTHER_BIN_LAYOUTS:
+        table = _bin_table(blob, dtype, columns)
+        if table is None or _plausible_share(table) < PLAUSIBLE_SHARE:
+            continue
+        if kitti is None:
+            why = f"its {len(blob)} bytes are no multiple of 16"
+        else:
+            far = np.abs(kitti[:, :3].astype(np.float64))
+            top = far[np.isfinite(far)].max(initial=0.0)
+            why = (f"read so, its points lie up to {top:.2g} m away" if top > MAX_POINT_RANGE_M
+                   else "read so, its reflectances are negative: its points are scrambled")
+        npy = path.with_suffix(".npy")
+        raise ValueError(f"{path}: a .bin of {columns} {dtype} per point ({what}), not KITTI's 4 float32 (x y z "
+                         f"reflectance; {why}); save it as a .npy, which records its layout: "
+                         f"np.save('{npy}', np.fromfile('{path}', np.{dtype}).reshape(-1, {columns}))")
+    if kitti is None:
+        raise ValueError(f"{path}: a KITTI .bin sweep holds 4 float32 per point (x y z reflectance); its size "
+                         f"({len(blob)} bytes) is not a multiple of 16: corrupt, or another format")
+    xyz_ok = _plausible_share(kitti[:, :3])
+    if xyz_ok < PLAUSIBLE_SHARE:
+        cause = ("millimetres? save x y z / 1000 (metres)" if _plausible_share(kitti[:, :3] / 1000) >= PLAUSIBLE_SHARE
+                 else "not a sweep in metres in any layout lipjax knows; save x y z metres")
+        raise ValueError(f"{path}: read as KITTI's float32 x y z reflectance, {100 * (1 - xyz_ok):.0f} % of its "
+                         f"points lie beyond {MAX_POINT_RANGE_M:g} m: {cause} as an (N, 3) .npy")
+    return np.array(kitti[:, :3])  # x y z in metres, only the 4th column odd (negative): not used
 
 
 def _read_pcd(path: pathlib.Path) -> np.ndarray:

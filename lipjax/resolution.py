@@ -19,14 +19,14 @@ below full size (0.38x, 132x455): the prox's receptive field and its training fr
 number of pixels, and a scan at its full 352x1216 leaves the prox's field of view a narrow slice of the street
 (the rows between beams, the sky above the top beam). Scattered samples carry no such structure, and capping them
 only throws their detail away. Dense maps (over DENSE samples a pixel: a depth camera's, stereo's,
-with holes) are capped as scan lines are (rule 50 of docs/design-notes.md: 8 synthetic 480x640 rooms with holes,
-0.9663 x linear at full size, 0.7508 at 212x283; the prox learned to fill gaps of a few working pixels, and a
-camera's holes are tens of pixels wide; every sample is set back at full size). The data-consistency step and
-the output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every
-measured pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
+with holes) are capped as scan lines are (docs/decisions/0017-dense-input-capped.md: 8 synthetic 480x640 rooms with
+holes, 0.9663 x linear at full size, 0.7508 at 212x283; the prox learned to fill gaps of a few working pixels, and a
+camera's holes are tens of pixels wide; every sample is set back at full size). The data-consistency step and the
+output stay at full resolution (`lipjax.inference.complete_frame`): the prox's estimate is upsampled and every measured
+pixel is set back to its measured value (the x-update with rho -> 0 at m = 1).
 
-The constants were chosen on synthetic renders larger than the training frames (`python
-benchmarks/working_resolution.py --model lip-any --frames 6`, geometric-mean RMSE ratio to the full-size linear fill
+The constants were chosen on synthetic renders larger than the training frames (`python -m
+benchmarks.working_resolution --model lip-any --frames 6`, geometric-mean RMSE ratio to the full-size linear fill
 over 50 to 5,000 points on 480x640 rooms and 200 or 25,000 points on 352x1216 streets for T and the scattered cap;
 over 64- and 32-beam scans on those streets for the scan-line cap), as the most accurate rule whose frames meet the
 speed target of 10 frames/s (normalised to 195 GFLOP/s, benchmarks/speed.py) at 480x640 with 200 points and at
@@ -100,5 +100,6 @@ def dense_from(pixels: int) -> int:
 
 def is_capped(samples: int, shape: tuple[int, int], scan_lines: bool) -> bool:
     """Whether `working_size` caps a frame of `shape` with `samples` samples at MAX_WORKING_PIXELS: LiDAR scan lines
-    (lipjax.inputs.is_lidar_pattern), or a dense map (`dense_from`; rule 50, module doc)."""
+    (lipjax.inputs.is_lidar_pattern), or a dense map (`dense_from`; docs/decisions/0017-dense-input-capped.md, module
+    doc)."""
     return scan_lines or samples >= dense_from(shape[0] * shape[1])

@@ -1,11 +1,11 @@
 """Spreads the samples' residuals over the frame once the working-size estimate is resized back to full size.
 
 Below full size the learned prox runs on a coarser grid (lipjax.resolution), and its estimate z, resized back
-(bilinear), cannot follow the measured depths y between working pixels: near the samples the full-size linear
-fill is closer than z (seen on renders scored where KITTI's ground truth lies: docs/design-notes.md, rule 46).
-The samples give it back. With r = y - z at the measured pixels (m = 1, else 0) and G a Gaussian of
-sigma = SIGMA_WORKING_PX working pixels along both axes for scattered samples and SCAN_LINE_SIGMAS_WORKING_PX
-(across the lines, along them) for LiDAR scan lines (in full-size pixels (H / h, W / w) times those),
+(bilinear), cannot follow the measured depths y between working pixels: near the samples the full-size linear fill is
+closer than z (seen on renders scored where KITTI's ground truth lies: docs/decisions/0018-residual-spreading.md). The
+samples give it back. With r = y - z at the measured pixels (m = 1, else 0) and G a Gaussian of sigma =
+SIGMA_WORKING_PX working pixels along both axes for scattered samples and SCAN_LINE_SIGMAS_WORKING_PX (across the
+lines, along them) for LiDAR scan lines (in full-size pixels (H / h, W / w) times those),
 
     x = max(z + (G * (m r)) / (G * m + delta), 0),     delta = DELTA G(0, 0)
 
@@ -24,11 +24,13 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-SIGMA_WORKING_PX = 0.5  # the Gaussian's sigma for scattered samples, in working pixels (rule 46)
-# LiDAR scan lines (sigma across the lines = along the rows' axis, sigma along them), in working pixels (rule 47):
-# their samples lie a pixel or two apart along a line and several working pixels apart across the lines
+# the Gaussian's sigma for scattered samples, in working pixels (docs/decisions/0018-residual-spreading.md)
+SIGMA_WORKING_PX = 0.5
+# LiDAR scan lines (sigma across the lines = along the rows' axis, sigma along them), in working pixels
+# (docs/decisions/0019-scan-line-sigmas.md): their samples lie a pixel or two apart along a line and several working
+# pixels apart across the lines
 SCAN_LINE_SIGMAS_WORKING_PX = (1.0, 0.25)
-DELTA = 0.05  # the fade: delta = DELTA x the Gaussian's centre weight (rule 46)
+DELTA = 0.05  # the fade: delta = DELTA x the Gaussian's centre weight (docs/decisions/0018)
 RADIUS_SIGMAS = 3.0  # the Gaussian's taps reach ceil(RADIUS_SIGMAS sigma) pixels either side
 
 

@@ -27,7 +27,7 @@ scattered samples are rarely in the same column).
 The constants were fitted on the synthetic VALIDATION splits (first 20 frames: indoor 200 uniform points,
 outdoor HDL-64 pattern; completions by `linear` and the shipped `lip-cnn-*` models): SPREAD_GAIN by least
 squares of |error| / z on the supported pixels (an extra term in r**2 * z was tried and fitted to 0), ABOVE_GAIN
-by least squares of |error| = gain * z above the samples. `python benchmarks/uncertainty.py --calibrate` refits
+by least squares of |error| = gain * z above the samples. `python -m benchmarks.uncertainty --calibrate` refits
 them; the same script reports the rank correlation with the actual error on the test splits and real frames.
 """
 from __future__ import annotations
@@ -173,7 +173,7 @@ def support_mask(sparse: np.ndarray) -> np.ndarray:
 
 def mask_unsupported(depth: np.ndarray, sparse: np.ndarray) -> np.ndarray:
     """A float32 copy of `depth` (metres) with 0 (no depth) where the samples of `sparse` (metres, same shape)
-    give no support (`support_mask`): what `lipjax complete` writes unless --fill-all."""
+    give no support (`support_mask`): what `lipjax complete --blank-unsupported` writes."""
     depth = np.asarray(depth, np.float32)
     if depth.shape != np.shape(sparse):
         raise ValueError(f"depth {depth.shape} and sparse depth {np.shape(sparse)} must have the same shape")

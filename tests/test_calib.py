@@ -2,6 +2,7 @@
 against the devkit's own formula (P2 @ R0_rect @ Tr_velo_to_cam in homogeneous coordinates) on a generated rig
 whose calibration files the tests write in KITTI's text formats."""
 import pathlib
+import warnings
 
 import numpy as np
 import pytest
@@ -247,3 +248,106 @@ def test_project_command_writes_the_sparse_image(tmp_path, capsys):
     assert cli.main(args[:-1] + [str(tmp_path / "sparse.png"), "--out", str(tmp_path / "x.npy")]) == 1
     err = capsys.readouterr().err
     assert err.startswith("lipjax: error: A 16-bit single-channel PNG is a depth map") and err.count("\n") == 1
+
+
+# A spinning LiDAR's sweep (32 beams from +2 to -24.8 degrees, every 0.5 degrees round, 1.73 m above a flat road
+# between walls 7 m to the left and 9 m to the right, 8 m high, nothing beyond 80 m) and a camera of 90 degrees on
+# the rig above: the geometry of a KITTI street, small.
+SH, SW, SF = 48, 160, 80.0
+SK = np.array([[SF, 0, (SW - 1) / 2], [0, SF, (SH - 1) / 2], [0, 0, 1]])
+
+
+def _street_sweep(path):
+    elevation, azimuth = np.meshgrid(np.deg2rad(np.linspace(2.0, -24.8, 32)), np.deg2rad(np.arange(0, 360, 0.5)),
+                                     indexing="ij")
+    rays = np.stack([np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)],
+                    -1).reshape(-1, 3)
+    reach = np.full(len(rays), np.inf)
+    down = rays[:, 2] < 0
+    reach[down] = -1.73 / rays[down, 2]
+    for y in (7.0, -9.0):
+        side = rays[:, 1] * np.sign(y) > 0
+        hit = np.where(side, y / np.where(side, rays[:, 1], 1.0), np.inf)
+        wall = side & (hit * rays[:, 2] <= 8.0) & (hit < reach)
+        reach[wall] = hit[wall]
+    seen = reach < 80
+    np.c_[rays[seen] * reach[seen, None], np.full(seen.sum(), 0.5)].astype(np.float32).tofile(path)
+    return path
+
+
+def _street_calib(path, tr=TR, k=SK):
+    lines = [f"P{i}: {_numbers(k @ np.c_[np.eye(3), OFFSETS[i]])}" for i in (2, 3)]
+    path.write_text("\n".join(lines + [f"R0_rect: {_numbers(R0)}", f"Tr_velo_to_cam: {_numbers(tr)}"]) + "\n")
+    return path
+
+
+def _warnings_of(fn, *args, **kwargs):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fn(*args, **kwargs)
+    return [str(w.message) for w in caught]
+
+
+def test_a_sweep_with_its_calibration_projects_without_a_warning(tmp_path):
+    sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
+    assert _warnings_of(project_sweep, sweep, calib, (SH, SW), image_path=tmp_path / "image_2" / "000000.png") == []
+    _, _, counts = project_sweep(sweep, calib, (SH, SW), return_counts=True)
+    assert counts.points == 22856 and counts.kept == 3253  # 14 % of the sweep, as on KITTI
+
+
+def test_an_inverted_transform_warns_that_the_points_lie_on_one_side(tmp_path):
+    """Issue 55: Tr_velo_to_cam inverted (the camera-to-LiDAR transform given) put 10,513 points of a KITTI sweep in
+    the image, completed as "indoor input"; its points lie mostly left of the image's centre (the road turns into
+    the image's left half), which warns."""
+    sweep = _street_sweep(tmp_path / "000000.bin")
+    calib = _street_calib(tmp_path / "calib.txt", tr=np.linalg.inv(_pad(TR))[:3])
+    assert _warnings_of(project_sweep, sweep, calib, (SH, SW)) == [
+        f"{sweep}: only 19 % of its 1553 points in the image lie in its right half, where a calibrated camera sees "
+        f"about half: is the transform in {calib} inverted (camera to LiDAR, not LiDAR to camera) or another rig's?"]
+
+
+def test_an_image_of_another_size_than_the_calibrations_warns(tmp_path):
+    """A half-size image: the principal point (79.5, 23.5) lies at its corner; one warning names it (the few points
+    and their one-sidedness follow from it and are not warned about too). A calibration zoomed in (the principal
+    point still central) lands under 2 % of the sweep in the image, which warns."""
+    sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
+    assert _warnings_of(project_sweep, sweep, calib, (SH // 2, SW // 2)) == [
+        f"{calib}: camera 2's principal point (79.5, 23.5) lies far from the centre (39.5, 11.5) of the 80x24 image: "
+        "was the image resized or cropped? resize or shift fx, fy, cx, cy with it"]
+    zoomed = _street_calib(tmp_path / "zoomed.txt", k=SK * [[10], [10], [1]] + [[0, 0, -9 * 79.5], [0, 0, -9 * 23.5],
+                                                                                 [0, 0, 0]])
+    assert _warnings_of(project_sweep, sweep, zoomed, (SH, SW)) == [
+        f"{sweep}: only 67 of its 22856 points land in the 160x48 image (under 2 %): was the image resized or "
+        f"cropped, or is {zoomed} another sweep's calibration?"]
+
+
+def test_the_camera_named_by_the_images_folder_must_be_the_one_chosen(tmp_path):
+    """Issue 55: --camera 3 with an image of image_2 (or the default camera 2 with one of image_3) was accepted
+    (P2 and P3 share fx, fy, cx, cy; only the 54 cm baseline differs). The folder of a KITTI image names its camera:
+    image_2 (object, odometry), image_02/data (raw); a rig file has one camera and no check."""
+    from lipjax.data.lidar import camera_of_image
+
+    assert [camera_of_image(p) for p in ("training/image_2/000000.png", "drive/image_03/data/0000000000.png",
+                                         "frames/000000.png", "image_2.png")] == [2, 3, None, None]
+    sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
+    image = tmp_path / "training" / "image_2" / "000000.png"
+    with pytest.raises(ValueError) as info:
+        project_sweep(sweep, calib, (SH, SW), camera=3, image_path=image)
+    assert str(info.value) == (f"{image}: its folder names KITTI camera 2 (image_2), but camera 3's projection was "
+                               f"taken from {calib}: give --camera 2")
+    raw = tmp_path / "drive" / "image_03" / "data" / "0000000000.png"
+    with pytest.raises(ValueError, match=r"names KITTI camera 3 \(image_3\), but camera 2's .*: give --camera 3$"):
+        project_sweep(sweep, calib, (SH, SW), image_path=raw)
+    project_sweep(sweep, calib, (SH, SW), camera=3, image_path=raw)
+    rig = tmp_path / "rig.txt"
+    rig.write_text(f"K: {_numbers(SK)}\nT_cam_from_lidar: {_numbers(_cam_from_velo(2))}\n")
+    project_sweep(sweep, rig, (SH, SW), camera=2, image_path=raw)  # one camera: nothing to choose
+
+
+def test_a_sweep_in_millimetres_is_an_error_naming_the_unit(tmp_path):
+    sweep = np.fromfile(_street_sweep(tmp_path / "000000.bin"), np.float32).reshape(-1, 4)[:, :3]
+    np.save(tmp_path / "mm.npy", sweep * 1000)
+    with pytest.raises(ValueError) as info:
+        project_sweep(tmp_path / "mm.npy", _street_calib(tmp_path / "calib.txt"), (SH, SW))
+    assert str(info.value) == (f"{tmp_path / 'mm.npy'}: its points in the image lie at a median depth of 9868: not "
+                               "metres (millimetres? divide by 1000)")

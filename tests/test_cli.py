@@ -18,7 +18,6 @@ from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
 from lipjax.priors.network import network_preset
 from lipjax.inference import complete_frame
-from lipjax.uncertainty import mask_unsupported
 
 from helpers import perturbed
 
@@ -131,12 +130,12 @@ def test_folder_batch_pairs_frames_by_trailing_number(model, tmp_path):
 
 
 def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, tmp_path):
-    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16", "--fill-all") == 0
+    assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16") == 0
     out = np.load(tmp_path / "out.npy")
     sparse = frame["sparse_array"]
     assert out.shape == (H, W)
     np.testing.assert_array_equal(out[sparse > 0], sparse[sparse > 0])
-    # The library's frame path at that size, value for value (--fill-all: no support mask).
+    # The library's frame path at that size, value for value.
     expected = complete_frame(model[1], frame["rgb_array"], sparse, max_side=16)
     np.testing.assert_allclose(out, expected, rtol=1e-6, atol=1e-6)
     assert not np.allclose(out, complete_frame(model[1], frame["rgb_array"], sparse), atol=1e-3)  # it did downsize
@@ -228,8 +227,7 @@ def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_
                    "--ply", str(tmp_path / "a.ply"), "-q"])
     assert rc == 0
     sparse, _ = project_sweep(tmp_path / "sweep.npy", calib, (40, 120))
-    # 0 above the scan: lipjax complete's default
-    expected = mask_unsupported(complete_frame(model[1], rgb, sparse), sparse)
+    expected = lipjax.complete(rgb, sparse, model=model[1])  # the default: depth everywhere, as the library's
     np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-6)
     np.save(tmp_path / "sparse.npy", sparse)
     for ply, intrinsics in (("b.ply", ["--intrinsics", str(FX), str(FY), str(CX), str(CY)]),
@@ -268,13 +266,14 @@ def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsy
     args = ["complete", "--rgb", rgb_path, "--depth", npy, "--model", model[0], "--out", str(out)]
     assert cli.main(args) == 0
     with pytest.warns(UserWarning, match="beyond the 10 m range"):
-        dense = mask_unsupported(complete_frame(model[1], rgb, sparse * 8), sparse * 8)
+        dense = complete_frame(model[1], rgb, sparse * 8)
     top = np.percentile(dense[dense > 0], 99)
     assert top > model[1].config.max_depth_m == 10  # beyond the model's range: the colours fit the output
     np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, top))
     err = capsys.readouterr().err.splitlines()
     assert err[0].startswith("lipjax: warning: sparse depth beyond the 10 m range of the indoor model")
-    assert err[1:] == [f"wrote {out}: colours 0-{top:.3g} m"]
+    holes = f"{100 * np.mean(dense == 0):.1f} % of the pixels left at 0 by {model[0]} (--fill-all fills them)"
+    assert err[1:] == [f"wrote {out}: {holes}; colours 0-{top:.3g} m"]  # the tiny model's estimate is 0 at some
     assert cli.main(args + ["--color-range", "0", "10", "-q"]) == 0
     np.testing.assert_array_equal(cv2.imread(str(out))[..., ::-1], viz.colorize_depth(dense, 0, 10))
 
@@ -473,3 +472,107 @@ def test_evaluate_working_size_scores_what_complete_returns(model, tmp_path):
         scores[tuple(flags)] = row["metrics"]
     assert scores[("--working-size",)]["mae_sampled_m"] == 0.0 < scores[()]["mae_sampled_m"]
     assert scores[("--working-size",)]["rmse_m"] != scores[()]["rmse_m"]
+
+
+@pytest.fixture(scope="module")
+def scan_frame(tmp_path_factory):
+    """A synthetic street seen by a 64-beam LiDAR (scan lines, sky above the top beam) on disk: rgb png, sparse npy;
+    and the arrays."""
+    from lipjax.data.sampling import LidarSampler
+    from lipjax.data.synthetic.dataset import render
+
+    street = render("outdoor", "test", 0, height=128, width=416)
+    sparse = LidarSampler.hdl64(azimuth_step_deg=0.5)(street)
+    rgb_path, npy = _write_frame(tmp_path_factory.mktemp("scan"), street.rgb, sparse, depth_name="sparse.npy")
+    return {"rgb": rgb_path, "npy": npy, "rgb_array": street.rgb, "sparse_array": sparse}
+
+
+@pytest.mark.parametrize("flag, setting", [(None, {}), ("--fill-all", {"fill_all": True}),
+                                           ("--blank-unsupported", {"blank_unsupported": True})])
+def test_the_written_map_is_what_lipjax_complete_returns_by_default_and_with_each_flag(flag, setting, model, frame,
+                                                                                       scan_frame, tmp_path):
+    """One default for the command and the library (depth as the model or method returns it), and one flag or
+    argument for each change: a learned model on scattered samples, IP-Basic on scan lines (which leaves 0s)."""
+    for inputs, name, completer in ((frame, model[0], model[1]), (scan_frame, "ip_basic", "ip_basic")):
+        assert cli.main(["complete", "--rgb", inputs["rgb"], "--depth", inputs["npy"], "--model", name, "--out",
+                         str(tmp_path / "out.npy"), "-q", *([flag] if flag else [])]) == 0
+        expected = lipjax.complete(inputs["rgb_array"], inputs["sparse_array"], model=completer, **setting)
+        np.testing.assert_allclose(np.load(tmp_path / "out.npy"), expected, rtol=1e-6, atol=0)
+    out = np.load(tmp_path / "out.npy")  # ip_basic's
+    assert (out == 0).any() == (flag != "--fill-all")  # IP-Basic leaves 0s as published; --fill-all fills them
+    assert (out[:20] == 0).all() == (flag != "--fill-all")  # the sky above the top beam
+
+
+def test_fill_all_fills_what_the_method_leaves_with_the_nearest_depth_and_keeps_the_rest(scan_frame):
+    from lipjax.classical import IPBasicFill, nearest_fill
+
+    rgb, sparse = scan_frame["rgb_array"], scan_frame["sparse_array"]
+    own = IPBasicFill()(rgb, sparse)
+    filled = lipjax.complete(rgb, sparse, model="ip_basic", fill_all=True)
+    assert (own == 0).mean() > 0.1 and (filled > 0).all()
+    np.testing.assert_array_equal(filled[own > 0], own[own > 0])
+    np.testing.assert_array_equal(filled, nearest_fill(own))
+
+
+def test_fill_all_and_blank_unsupported_contradict_in_one_line(frame, capsys):
+    args = ["complete", "--rgb", frame["rgb"], "--depth", frame["npy"], "--out", "o.npy", "--model", "linear"]
+    assert cli.main(args + ["--fill-all", "--blank-unsupported"]) == 2
+    assert "not allowed with argument --fill-all" in _one_error_line(capsys.readouterr().err)
+    with pytest.raises(ValueError, match="contradict each other; pass one of them"):
+        lipjax.complete(frame["rgb_array"], frame["sparse_array"], model="linear", fill_all=True,
+                        blank_unsupported=True)
+
+
+@pytest.mark.parametrize("command", [
+    ["complete", "--rgb", "a.png", "--out", "b.npy"],
+    ["project", "--rgb", "a.png", "--lidar", "s.bin", "--calib", "c.txt", "--out", "b.npy"],
+    ["evaluate"],
+    ["export", "--height", "8", "--width", "8", "--out", "m.onnx"],
+    ["data", "render", "--kind", "indoor", "--count", "1", "--out", "d"],
+    ["train", "--data", "d", "--out", "m"],
+])
+def test_every_command_that_prints_progress_or_status_takes_q_and_quiet(command):
+    parser = cli.build_parser()
+    assert parser.parse_args(command + ["-q"]).quiet and parser.parse_args(command + ["--quiet"]).quiet
+    assert not parser.parse_args(command).quiet
+
+
+def test_help_pages_load_no_jax():
+    """`lipjax --help` and every command's page are built without importing JAX, Flax, SciPy or OpenCV (lipjax.cli
+    imports the library inside the commands; the values the pages show are lipjax.cli_help's)."""
+    code = ("import sys\nfrom lipjax import cli\nfor command in ([], ['complete'], ['project'], ['evaluate'], "
+            "['export'], ['models'], ['train'], ['data'], ['data', 'render']):\n"
+            "    assert cli.main(command + ['--help']) == 0\n"
+            "heavy = sorted({m.split('.')[0] for m in sys.modules} & {'jax', 'flax', 'scipy', 'cv2', 'optax'})\n"
+            "print('loaded:', heavy, file=sys.stderr)")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0 and result.stderr.strip().splitlines()[-1] == "loaded: []", result.stderr
+
+
+def test_the_help_values_are_the_librarys():
+    """lipjax.cli_help copies values of the library so that the help loads no JAX: each copy equals its source."""
+    from lipjax import cli_help, evaluate, methods
+    from lipjax.data import folder, protocols, sources, synthetic
+    from lipjax.train import folder as train_folder
+
+    assert cli_help.OUT_FORMATS == folder.OUT_FORMATS
+    assert (cli_help.SOURCES, cli_help.NO_PROTOCOL) == (sources.SOURCES, sources.NO_PROTOCOL)
+    assert cli_help.PROTOCOLS == tuple(sorted(protocols.PROTOCOLS))
+    assert (cli_help.SPLITS, cli_help.SYNTHETIC_KINDS) == (synthetic.SPLITS, synthetic.SYNTHETIC_KINDS)
+    assert cli_help.DEFAULT_COLUMNS == evaluate.DEFAULT_COLUMNS
+    assert cli_help.CLASSICAL == tuple(methods.CLASSICAL) == tuple(methods.CLASSICAL_SUMMARY)
+    training = cli_help.TRAINING
+    assert (training.steps, training.batch_size) == (train_folder.FOLDER_STEPS, train_folder.FOLDER_BATCH_SIZE)
+    assert (training.crop, training.workers) == (train_folder.FOLDER_DATA.crop, train_folder.FOLDER_DATA.num_workers)
+    assert cli.build_parser().parse_args(["complete", "--rgb", "a", "--out", "b", "--depth-scale", "nyu"]
+                                         ).depth_scale == folder.parse_depth_scale("nyu")
+
+
+def test_models_lists_the_hand_crafted_methods_after_the_shipped(capsys):
+    from lipjax.methods import CLASSICAL
+
+    assert cli.main(["models"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    start = lines.index("HAND-CRAFTED (no weights, no training; --model NAME runs each as the method returns it):")
+    assert [line.split()[0] for line in lines[start + 1:]] == list(CLASSICAL)
+    assert start > len(lipjax.available_models()) and max(len(line) for line in lines) < 120

@@ -262,7 +262,7 @@ def test_threads_flag_limits_the_process_before_the_run(model, tmp_path, monkeyp
     and reads with at most N threads; the outputs do not change."""
     data = _frames(tmp_path / "in", ["0", "1"])
     called, workers = [], []
-    monkeypatch.setattr(cli, "limit_cpu_threads", called.append)
+    monkeypatch.setattr(lipjax.utils, "limit_cpu_threads", called.append)
     real = files.prefetched
     monkeypatch.setattr(files, "prefetched", lambda read, items, n: workers.append(n) or real(read, items, n))
     assert _complete("nearest", data / "rgb", data / "depth", tmp_path / "a", "--threads", "1", "-q") == 0
@@ -295,6 +295,123 @@ def test_the_summary_line_names_the_rate_the_masked_share_and_the_fitted_colours
     two = files.Completed([pathlib.Path("o/a.png"), pathlib.Path("o/b.png")], [], pathlib.Path("o"), 0.8, 0.25,
                           (0.0, 42.0))
     assert two.summary() == ("wrote 2 frame(s) to o in 0.8 s: 2.5 frames/s; 25.0 % of the pixels without support set "
-                             "to 0 (--fill-all keeps them); colours 0-42 m")
+                             "to 0 (--blank-unsupported); colours 0-42 m")
     one = files.Completed([pathlib.Path("d.npy")], [pathlib.Path("c.ply")], pathlib.Path("d.npy"), 3.0, 0.0, None)
     assert one.summary() == "wrote d.npy and c.ply"
+    holes = files.Completed([pathlib.Path("d.npy")], [], pathlib.Path("d.npy"), 1.0, 0.0, None, 0.357, False,
+                            "ip_basic")
+    assert holes.summary() == "wrote d.npy: 35.7 % of the pixels left at 0 by ip_basic (--fill-all fills them)"
+    filled = files.Completed([pathlib.Path("d.npy")], [], pathlib.Path("d.npy"), 1.0, 0.0, None, 0.357, True)
+    assert filled.summary() == "wrote d.npy: 35.7 % of the pixels given the nearest depth (--fill-all)"
+
+
+class _Counting:
+    """A completer that counts its calls (a nearest fill)."""
+
+    name = "counting"
+
+    def __init__(self):
+        self.calls = 0
+
+    def __call__(self, rgb, sparse):
+        self.calls += 1
+        return get_completer("nearest")(rgb, sparse)
+
+
+@pytest.mark.parametrize("flag", ["--out", "--ply", "--uncertainty"])
+def test_an_output_folder_that_cannot_be_written_fails_first_naming_it(tmp_path, monkeypatch, flag):
+    """A read-only output folder (os.access says so, as on a read-only mount; root may write anywhere else) fails
+    before any frame is read or completed, in one line naming the flag and the folder, for one frame and folders."""
+    root = _frames(tmp_path / "in", ["a", "b"])
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode, **kw: pathlib.Path(path) != locked and
+                        real_access(path, mode, **kw))
+    outputs = {"--out": tmp_path / "out", "--ply": tmp_path / "ply", "--uncertainty": tmp_path / "u"}
+    outputs[flag] = locked / "sub"  # not there yet: made by the writers, so its parent decides
+    completer, names = _Counting(), {"--out": "a.npy", "--ply": "a.ply", "--uncertainty": "a.npy"}
+    for rgb, depth, single in ((root / "rgb", root / "depth", False), (root / "rgb/a.png", root / "depth/a.png",
+                                                                      True)):
+        paths = {k: v / names[k] if single else v for k, v in outputs.items()}
+        with pytest.raises(ValueError) as error:
+            files.complete_files(rgb, depth, paths["--out"], ply=paths["--ply"], uncertainty=paths["--uncertainty"],
+                                 depth_scale=SCALE, model=completer, intrinsics=(30, 30, 15.5, 11.5), progress=False)
+        message = str(error.value)
+        assert message.startswith(f"{flag} {paths[flag]}: cannot write in the folder {locked} (read-only or no "
+                                  f"permission); choose another {flag} or make the folder writable"), message
+        assert "\n" not in message
+    assert completer.calls == 0 and not (tmp_path / "out").exists()
+
+
+def test_a_file_where_the_output_folder_should_be_fails_first_in_one_line(model, tmp_path, capsys):
+    root = _frames(tmp_path / "in", ["a"])
+    (tmp_path / "taken").write_text("a file")
+    rc = _complete(model, root / "rgb" / "a.png", root / "depth" / "a.png", tmp_path / "taken" / "out.npy")
+    assert rc == 1 and capsys.readouterr().err == (f"lipjax: error: --out {tmp_path / 'taken' / 'out.npy'}: "
+                                                   f"{tmp_path / 'taken'} is a file, not a folder; choose another "
+                                                   "--out\n")
+    rc = cli.main(["project", "--rgb", str(root / "rgb" / "a.png"), "--lidar", "no-sweep.bin", "--calib", "no.txt",
+                   "--out", str(tmp_path / "taken" / "sparse.npy")])  # checked before the sweep is read
+    assert rc == 1 and "is a file, not a folder; choose another --out" in capsys.readouterr().err
+
+
+def _scan_lines(depth_m, seed=0):
+    """(H, W) samples in LiDAR scan lines (every 4th row from row 8, every 2nd column), depth_m x 0.5-2."""
+    sparse = np.zeros((H, W))
+    sparse[8::4, ::2] = depth_m * np.random.default_rng(seed).uniform(0.5, 2.0, sparse[8::4, ::2].shape)
+    return sparse
+
+
+def test_an_integer_npy_depth_is_an_error_naming_its_dtype_and_unit(tmp_path):
+    """Issue 55: an int32 .npy was read as metres (depths truncated, or millimetres taken for metres) without a word.
+    Depth .npy is float metres: integers are a one-line error naming the dtype, the likely unit and the fix; also
+    from `complete_files`, before any model runs."""
+    cv2.imwrite(str(tmp_path / "rgb.png"), np.zeros((H, W, 3), np.uint8))
+    fix = "save it as float32 metres, e.g. depth.astype(np.float32) /"
+    cases = {"mm.npy": (np.round(_scan_lines(15.0) * 1000).astype(np.int32),
+                        f"(median 19502), not float metres (millimetres? divide by 1000): {fix} 1000"),
+             "cm.npy": (np.round(_scan_lines(15.0) * 100).astype(np.int32),
+                        f"(median 1950), not float metres (centimetres? divide by 100): {fix} 100"),
+             "m.npy": (_scan_lines(15.0).astype(np.uint16), "(median 19), not float metres: metres cut to whole "
+                       "numbers? save the depth as float32 metres before any cast to an integer type")}
+    for name, (depth, tail) in cases.items():
+        np.save(tmp_path / name, depth)
+        with pytest.raises(ValueError) as info:
+            files.read_depth_frame(tmp_path / "rgb.png", tmp_path / name, None)
+        assert str(info.value) == f"{tmp_path / name}: depth .npy holds {depth.dtype} (integer) values {tail}", name
+    with pytest.raises(ValueError, match=r"mm\.npy: depth \.npy holds int32 \(integer\) values"):
+        files.complete_files(tmp_path / "rgb.png", tmp_path / "mm.npy", tmp_path / "out.npy", model="linear",
+                             progress=False)
+    assert not (tmp_path / "out.npy").exists()
+    np.save(tmp_path / "metres.npy", _scan_lines(15.0).astype(np.float32))  # the fix
+    assert files.read_depth_frame(tmp_path / "rgb.png", tmp_path / "metres.npy", None)[1].dtype == np.float32
+
+
+def test_a_millimetre_png_read_at_kittis_scale_warns_with_the_scale_that_fits(tmp_path):
+    """Issue 55: a millimetre PNG of a street read with --depth-scale 256 reached 421 m, without a word."""
+    cv2.imwrite(str(tmp_path / "rgb.png"), np.zeros((H, W, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "mm.png"), np.round(_scan_lines(20.0) * 1000).astype(np.uint16))
+    with pytest.warns(UserWarning) as caught:
+        files.read_depth_frame(tmp_path / "rgb.png", tmp_path / "mm.png", 256.0)
+    assert [str(w.message) for w in caught] == [
+        "depth PNG read with --depth-scale 256 puts over 5 % of its samples beyond 85 m, the deepest range of any "
+        "model: millimetres? --depth-scale 1000 fits it"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        files.read_depth_frame(tmp_path / "rgb.png", tmp_path / "mm.png", 1000.0)
+
+
+def test_project_file_checks_the_camera_its_images_folder_names(tmp_path):
+    """`lipjax project` with an image of image_3 and the default --camera 2: a one-line error naming the fix."""
+    from test_calib import _street_calib, _street_sweep
+
+    image = tmp_path / "image_3" / "000000.png"
+    image.parent.mkdir()
+    cv2.imwrite(str(image), np.zeros((48, 160, 3), np.uint8))
+    sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
+    with pytest.raises(ValueError) as info:
+        files.project_file(image, sweep, calib, tmp_path / "sparse.npy")
+    assert str(info.value) == (f"{image}: its folder names KITTI camera 3 (image_3), but camera 2's projection was "
+                               f"taken from {calib}: give --camera 3")
+    assert files.project_file(image, sweep, calib, tmp_path / "sparse.npy", camera=3).counts.kept > 0

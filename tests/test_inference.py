@@ -224,8 +224,8 @@ def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the
 @pytest.mark.filterwarnings("ignore:samples in LiDAR scan lines")  # a tiny model trained on neither
 def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
     """mirror=None (the default of complete_at, lipjax.complete): averaged with the mirror image on LiDAR scan lines,
-    where the check does not run (rule 54), and not on scattered samples; True and False force it either way; a
-    classical fill is never mirrored by default."""
+    where the check does not run (docs/decisions/0020), and not on scattered samples; True and False force it either
+    way; a classical fill is never mirrored by default."""
     from lipjax.inference import complete_at, is_lidar_pattern, mirrors
 
     completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
@@ -280,7 +280,8 @@ def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estim
     np.testing.assert_array_equal(got[sparse > 0], sparse[sparse > 0])
     full = [complete_at(completer, rgb, sparse, (40, 56), cross_check=False, spread=s) for s in (True, False)]
     np.testing.assert_array_equal(*full)
-    lines = np.zeros_like(sparse)  # LiDAR scan lines: the spread's sigmas are those of scan lines (rule 47)
+    # LiDAR scan lines: residual spreading's sigmas are those of scan lines (docs/decisions/0019)
+    lines = np.zeros_like(sparse)
     lines[1::4] = np.where(rng.random((10, 56)) < 0.8, rng.uniform(1, 8, (10, 56)), 0)
     assert is_lidar_pattern(lines)
     small = completer(cv2.resize(rgb, (28, 20), interpolation=cv2.INTER_AREA), reproject_sparse(lines, (20, 28)))

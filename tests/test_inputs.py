@@ -123,3 +123,49 @@ def test_the_completer_checks_against_its_range():
         lipjax.Completer.random()(rgb, _lidar(20.0))
     with pytest.raises(InputError, match="over 10x the 10 m range of random"):
         lipjax.Completer.random()(rgb, _lidar(300.0))
+
+
+def test_the_unit_hint_names_the_unit_the_values_fit():
+    """Issue 55: centimetres (values ~100x metres) were hinted as "millimetres? divide by 1000". The hint now names
+    the unit that puts the median sample in a real scene's range: scan lines are a street (cm: 19 m; mm: 19 m),
+    scattered samples a room first (mm: 3.5 m), and where two units fit, both, the likelier first."""
+    rgb = np.zeros((96, 200, 3), np.uint8)
+    for sparse, hint in ((_lidar(15.0) * 100, "centimetres? divide by 100"),
+                         (_lidar(15.0) * 1000, "millimetres? divide by 1000"),
+                         (_lidar(4.0) * 1000, "millimetres? divide by 1000; centimetres? by 100"),
+                         (_scattered(3.0, 4.0, shape=(96, 200)) * 1e6,
+                          "divide by its units per metre: 100 for centimetres, 1000 for millimetres")):
+        with pytest.raises(InputError) as info:
+            check_inputs(rgb, sparse)
+        median = np.median(sparse[sparse > 0])
+        assert str(info.value) == f"sparse depth has a median of {median:.0f}: not metres ({hint})"
+    with pytest.raises(InputError) as info:
+        check_for_model(_lidar(7.0) * 100, *OUTDOOR)  # a median of 9 m in centimetres: over 10x 85 m
+    assert str(info.value) == ("sparse depth has a median of 894 m, over 10x the 85 m range of lip-cnn-outdoor: not "
+                               "metres (centimetres? divide by 100)")
+    with pytest.raises(InputError) as info:
+        check_for_model(_scattered(0.55, 0.65) * 1000, *INDOOR)  # 0.6 m in millimetres or 6 m in centimetres
+    assert str(info.value).endswith("over 10x the 10 m range of lip-cnn-indoor: not metres (centimetres? divide by "
+                                    "100; millimetres? by 1000)")
+
+
+def test_a_png_scale_that_puts_the_samples_beyond_every_models_range_warns_with_the_scale_that_fits():
+    """Issue 55: a millimetre PNG of a street read with --depth-scale 256 put 23 % of its samples beyond 85 m
+    without a word; over 5 % beyond it now warns, naming the known scale that fits."""
+    from lipjax.inputs import check_depth_scale
+
+    def warned(depth_m, scale):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            check_depth_scale(depth_m, scale)
+        return [str(w.message) for w in caught]
+
+    street_mm = np.round(_lidar(20.0) * 1000)  # 10-40 m, as a millimetre PNG holds it
+    assert warned(street_mm / 256, 256) == [
+        "depth PNG read with --depth-scale 256 puts over 5 % of its samples beyond 85 m, the deepest range of any "
+        "model: millimetres? --depth-scale 1000 fits it"]
+    assert warned(street_mm / 1000, 1000) == []
+    assert warned(np.round(_lidar(20.0) * 5000) / 1000, 1000)[0].endswith(
+        "TUM's 5000 per metre? --depth-scale 5000 fits it")
+    assert warned(_lidar(500.0), 5000)[0].endswith(
+        "beyond 85 m, the deepest range of any model: give the PNG's value per metre as --depth-scale")

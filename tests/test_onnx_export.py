@@ -72,7 +72,7 @@ def test_the_working_size_is_fixed_from_the_sample_count_for_an_interval_of_coun
     assert hi == 352 * 1216 and 1 < lo < 20000 and export_working_size(352, 1216, lo) == size
     assert export_working_size(352, 1216, lo - 1) != size
     # as many scattered points: no cap, the full size, for every count whose spacing is under about 22 px, up to
-    # DENSE samples a pixel; a dense map beyond that is capped as scan lines are (rule 50)
+    # DENSE samples a pixel; a dense map beyond that is capped as scan lines are (docs/decisions/0017)
     assert export_working_size(352, 1216, 20000, scan_lines=False) == (352, 1216)
     lo, hi = samples_interval(352, 1216, 20000, scan_lines=False)
     assert hi == math.floor(DENSE * 352 * 1216)
@@ -168,8 +168,8 @@ def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_pa
 
 def test_a_scan_line_export_averages_with_the_mirror_image_as_complete_does(auto_model, tmp_path):
     """export_onnx on LiDAR scan lines holds the frame and its mirror image in one batch (lax.rev as ONNX Slice with
-    step -1), by default as with mirror=True, and equals lipjax.complete's default path there, which averages with
-    the mirror image on scan lines (rule 54); mirror=False (--no-mirror) leaves it out, as complete does."""
+    step -1), by default as with mirror=True, and equals lipjax.complete's default path there, which averages with the
+    flipped frame on scan lines (docs/decisions/0020); mirror=False (--no-mirror) leaves it out, as complete does."""
     b, h, w = 2, 48, 64
     written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b)
     plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b, mirror=False)

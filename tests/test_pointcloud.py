@@ -129,3 +129,70 @@ def test_ply_round_trip(tmp_path, binary):
     write_ply(path, points[:5], binary=binary)
     v = _read_ply(path)
     assert v.dtype.names == ("x", "y", "z") and len(v) == 5
+
+
+def _xyzi(n=400, seed=0):
+    """A sweep as KITTI stores it: x, y within 40 m, z from 2 m below the sensor to 1 m above, reflectance 0-1."""
+    rng = np.random.default_rng(seed)
+    return np.c_[rng.uniform(-40, 40, (n, 2)), rng.uniform(-2, 1, n), rng.random(n)].astype(np.float32)
+
+
+def _bin_fix(path, columns, dtype):
+    return (f"save it as a .npy, which records its layout: np.save('{path.with_suffix('.npy')}', "
+            f"np.fromfile('{path}', np.{dtype}).reshape(-1, {columns}))")
+
+
+def test_a_bin_in_another_layout_is_an_error_naming_it_and_its_fix(tmp_path):
+    """Issue 55: a float64 .bin, a 3-column one (whose size is or is not a multiple of 16) and a nuScenes one (5
+    columns) read as KITTI's float32 x y z reflectance gave garbage; each is now one line naming its layout (and
+    why KITTI's does not fit) and how to save it as a .npy. KITTI's own layout reads as before."""
+    from lipjax.pointcloud import read_point_cloud
+
+    xyzi = _xyzi()
+    xyzi.tofile(tmp_path / "kitti.bin")
+    np.testing.assert_array_equal(read_point_cloud(tmp_path / "kitti.bin"), xyzi[:, :3])
+    cases = {"f64.bin": (xyzi.astype(np.float64), 4, "float64", "x y z reflectance",
+                         "read so, its points lie up to 3.7e+19 m away"),
+             "xyz.bin": (xyzi[:, :3], 3, "float32", "x y z",
+                         "read so, its reflectances are negative: its points are scrambled"),
+             "xyz_odd.bin": (xyzi[:-1, :3], 3, "float32", "x y z", "its 4788 bytes are no multiple of 16"),
+             "nuscenes.bin": (np.c_[xyzi, np.full(len(xyzi), 7.0, np.float32)], 5, "float32",
+                              "x y z intensity ring, as nuScenes",
+                              "read so, its reflectances are negative: its points are scrambled")}
+    for name, (table, columns, dtype, what, why) in cases.items():
+        path = tmp_path / name
+        table.tofile(path)
+        with pytest.raises(ValueError) as info:
+            read_point_cloud(path)
+        assert str(info.value) == (f"{path}: a .bin of {columns} {dtype} per point ({what}), not KITTI's 4 float32 "
+                                   f"(x y z reflectance; {why}); {_bin_fix(path, columns, dtype)}"), name
+    np.save(tmp_path / "xyz.npy", np.fromfile(tmp_path / "xyz.bin", np.float32).reshape(-1, 3))  # the fix works
+    np.testing.assert_array_equal(read_point_cloud(tmp_path / "xyz.npy"), xyzi[:, :3])
+
+
+def test_a_bin_in_millimetres_or_of_no_known_layout_is_an_error(tmp_path):
+    from lipjax.pointcloud import read_point_cloud
+
+    (_xyzi() * 1000).tofile(tmp_path / "mm.bin")
+    with pytest.raises(ValueError) as info:
+        read_point_cloud(tmp_path / "mm.bin")
+    assert str(info.value) == (f"{tmp_path / 'mm.bin'}: read as KITTI's float32 x y z reflectance, 100 % of its "
+                               "points lie beyond 1000 m: millimetres? save x y z / 1000 (metres) as an (N, 3) .npy")
+    np.full((400, 4), 1e7, np.float32).tofile(tmp_path / "far.bin")
+    with pytest.raises(ValueError) as info:
+        read_point_cloud(tmp_path / "far.bin")
+    assert str(info.value) == (f"{tmp_path / 'far.bin'}: read as KITTI's float32 x y z reflectance, 100 % of its "
+                               "points lie beyond 1000 m: not a sweep in metres in any layout lipjax knows; save "
+                               "x y z metres as an (N, 3) .npy")
+
+
+def test_a_kitti_bin_with_missing_returns_or_odd_reflectance_still_reads(tmp_path):
+    """NaN points (no return) are left to the projection; a 4th column with negative values, where no other layout
+    fits, is a KITTI sweep whose reflectance is odd (it is not used)."""
+    from lipjax.pointcloud import read_point_cloud
+
+    xyzi = _xyzi()
+    xyzi[::10, :3] = np.nan
+    xyzi[:, 3] = -1.0
+    xyzi[:-2].tofile(tmp_path / "odd.bin")  # 398 points: no 3-column reading fits their 6368 bytes
+    np.testing.assert_array_equal(read_point_cloud(tmp_path / "odd.bin"), xyzi[:-2, :3])

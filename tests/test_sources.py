@@ -352,12 +352,12 @@ def test_lipjax_train_on_a_folder_exports_a_model_that_completes(tmp_path):
     model = tmp_path / "model"
     train = subprocess.run([sys.executable, "-m", "lipjax.cli", "train", "--data", str(root), "--out", str(model),
                             "--depth-scale", "1000", "--steps", "2", "--batch-size", "2", "--crop", "24", "32",
-                            "--workers", "0", "--init", "lip-cnn-indoor",
+                            "--workers", "0", "--init", "lip-cnn-indoor", "--keep", "last",
                             "--workdir", str(tmp_path / "run"), "--quiet"],
                            capture_output=True, text=True, timeout=600)
     assert train.returncode == 0, train.stderr[-3000:]
     done = complete(model, root / "rgb" / "0000.png", root / "sparse" / "0000.png", tmp_path / "out.npy",
-                    "--depth-scale", "1000", "--fill-all")  # every pixel, as lipjax.complete returns them
+                    "--depth-scale", "1000")
     assert done.returncode == 0, done.stderr[-3000:]
     import lipjax
     from lipjax.data.folder import read_depth, read_rgb
@@ -389,7 +389,7 @@ def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_a
     (root / "intrinsics.txt").unlink()
     out = tmp_path / "models" / "mine"
     assert cli.main(["train", "--data", str(root), "--out", str(out), "--depth-scale", "1000", "--steps", "2",
-                     "--batch-size", "2", "--crop", "24", "32", "--workers", "0",
+                     "--batch-size", "2", "--crop", "24", "32", "--workers", "0", "--keep", "last",
                      "--workdir", str(tmp_path / "run")]) == 0
     captured = capsys.readouterr()
     init, scene, why = default_init(root=str(root), depth_scale=1000.0)
@@ -402,8 +402,10 @@ def test_lipjax_train_starts_from_the_default_model_names_the_export_after_out_a
     assert start["rmse_m"] == pytest.approx(want["rmse_m"], rel=1e-6)
     lines = captured.out.splitlines()
     assert f"[lipjax] step 0 (start) val rmse_m={start['rmse_m']:.4f} mae_m={start['mae_m']:.4f}" in lines
-    assert lines[-1] == (f"[lipjax] exported mine (step 2) to {out}: val rmse_m={end['rmse_m']:.4f} "
-                         f"({start['rmse_m']:.4f} at step 0)")
+    worse = end["rmse_m"] > start["rmse_m"]  # --keep last exports the end either way, and says which it was
+    before = (f", WORSE than {start['rmse_m']:.4f} at step 0 (the last, as asked; keep best exports the start)"
+              if worse else f" ({start['rmse_m']:.4f} at step 0)")
+    assert lines[-1] == f"[lipjax] exported mine (step 2) to {out}: val rmse_m={end['rmse_m']:.4f}{before}"
     meta = model_io.metadata(out)
     assert meta["train_config"] == "mine" and meta["val_metrics"]["rmse_m"] == end["rmse_m"]
 

@@ -62,7 +62,7 @@ def test_nothing_to_spread_leaves_z_and_depth_stays_non_negative():
 
 def test_the_sigmas_in_working_pixels_and_a_batch_is_frame_by_frame():
     assert spread_sigmas_px((352, 1216), (132, 456)) == pytest.approx((0.5 * 352 / 132, 0.5 * 1216 / 456))
-    # scan lines: a working pixel across the lines (rows), a quarter along them (rule 47)
+    # scan lines: a working pixel across the lines (rows), a quarter along them (docs/decisions/0019)
     assert spread_sigmas_px((352, 1216), (132, 456), scan_lines=True) == pytest.approx((352 / 132, 0.25 * 1216 / 456))
     rng = np.random.default_rng(2)
     z = rng.uniform(1, 10, (2, 12, 18)).astype(np.float32)

@@ -129,16 +129,16 @@ def _cli(args):
 
 
 def test_cli_writes_the_expected_error_in_metres_and_zero_depth_without_support(tmp_path, capsys):
-    """By default the depth output and the PLY are 0 where no sample supports them (support_mask: here the rows
-    more than one spacing above the top scan line), and the summary line says how much; --fill-all writes the
-    dense map; the uncertainty file keeps every pixel either way."""
+    """With --blank-unsupported the depth output and the PLY are 0 where no sample supports them (support_mask: here
+    the rows more than one spacing above the top scan line), and the summary line says how much; by default the
+    dense map, as lipjax.complete returns it; the uncertainty file keeps every pixel either way."""
     import lipjax
     from lipjax import cli
 
     rgb, sparse, args = _cli_frame(tmp_path / "in")
     ply = ["--ply", tmp_path / "c.ply", "--intrinsics", 40, 40, 23.5, 17.5]
     assert cli.main(["complete"] + [str(a) for a in args + ["--out", tmp_path / "d.npy", "--uncertainty",
-                                                              tmp_path / "u.npy"] + ply]) == 0
+                                                              tmp_path / "u.npy", "--blank-unsupported"] + ply]) == 0
     dense = lipjax.complete(rgb, sparse, model="linear")
     support = uncertainty.support_mask(sparse)
     u = np.load(tmp_path / "u.npy")
@@ -152,8 +152,8 @@ def test_cli_writes_the_expected_error_in_metres_and_zero_depth_without_support(
     assert f"element vertex {int(support.sum())}" in header
     share = 100 * (~support).sum() / support.size
     assert capsys.readouterr().err == (f"wrote {tmp_path / 'd.npy'} and {tmp_path / 'c.ply'}: {share:.1f} % of the "
-                                       "pixels without support set to 0 (--fill-all keeps them)\n")
-    assert _cli(args + ["--out", tmp_path / "full.npy", "--uncertainty", tmp_path / "u2.npy", "--fill-all"]) == 0
+                                       "pixels without support set to 0 (--blank-unsupported)\n")
+    assert _cli(args + ["--out", tmp_path / "full.npy", "--uncertainty", tmp_path / "u2.npy"]) == 0
     np.testing.assert_allclose(np.load(tmp_path / "full.npy"), dense, rtol=1e-6)
     np.testing.assert_array_equal(np.load(tmp_path / "u2.npy"), u)
 
@@ -189,7 +189,7 @@ def test_cli_uncertainty_folder_gets_one_npy_per_frame(tmp_path):
     (tmp_path / "depth").mkdir()
     (tmp_path / "f.npy").rename(tmp_path / "depth" / "f.npy")
     rc = _cli(["--rgb", tmp_path / "rgb", "--depth", tmp_path / "depth", "--model", "linear", "--out", tmp_path / "o",
-               "--uncertainty", tmp_path / "u"])
+               "--uncertainty", tmp_path / "u", "--blank-unsupported"])
     assert rc == 0
     dense = lipjax.complete(rgb, sparse, model="linear")
     np.testing.assert_allclose(np.load(tmp_path / "o" / "f.npy"), uncertainty.mask_unsupported(dense, sparse),

@@ -14,6 +14,9 @@ name through the one resolver, lipjax.methods.get_completer:
   LIPWavelet              the paper's LIP+Wavelet baseline: the ADMM solver with    ignores RGB   lip_wavelet.py
                           the wavelet soft-thresholding prox (lipjax.priors.wavelet)
 
+`fill_holes` gives depth to the pixels a method leaves at 0 (the nearest pixel's with depth): what
+`lipjax complete --fill-all` adds to the methods that leave some (ip_basic, ip_basic_multiscale).
+
 Each checks its inputs with lipjax.inputs.check_frame: InputError (a ValueError) for an empty sparse map,
 mismatched shapes, NaN / inf or negative depth.
 """
@@ -29,7 +32,7 @@ from lipjax.classical.ipbasic import (
     ip_basic_adaptive,
     ip_basic_multiscale,
 )
-from lipjax.classical.nearest import NearestFill, nearest_fill
+from lipjax.classical.nearest import NearestFill, fill_holes, nearest_fill
 
 __all__ = [
     "ColorizationFill",
@@ -39,6 +42,7 @@ __all__ = [
     "LinearFill",
     "NearestFill",
     "colorization_fill",
+    "fill_holes",
     "ip_basic",
     "ip_basic_adaptive",
     "ip_basic_multiscale",

@@ -24,6 +24,19 @@ def nearest_fill(sparse: np.ndarray) -> np.ndarray:
     return sparse[iy, ix].astype(np.float32)
 
 
+def fill_holes(depth: np.ndarray) -> np.ndarray:
+    """(H, W) or (B, H, W) metres with 0 where a completion gave no depth -> float32 with depth at every pixel: each
+    0 takes the depth of the nearest pixel that has some (`nearest_fill` of the map itself); the rest is kept as it
+    is. What `--fill-all` / `lipjax.complete(..., fill_all=True)` does to a method that leaves holes (IP-Basic far
+    from its samples). A map without any depth is returned as it is."""
+    depth = np.asarray(depth, np.float32)
+    if depth.ndim == 3:
+        return np.stack([fill_holes(d) for d in depth])
+    if (depth > 0).all() or not (depth > 0).any():
+        return depth
+    return nearest_fill(depth)
+
+
 @dataclasses.dataclass(frozen=True)
 class NearestFill:
     """DepthCompleter: nearest-neighbour fill (ignores the RGB image)."""

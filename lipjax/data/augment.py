@@ -12,8 +12,9 @@ What each part is for (real sensors and real frames differ from the synthetic re
   interpolation, ground truth by nearest neighbour (depths are never averaged across edges), and every sparse
   sample moves to the pixel of the new grid it falls in, the nearest depth winning where several meet.
 - quarter turn: with probability `quarter_turn_prob` the whole frame is turned by 90 degrees, either way, before the
-  crop (a phone or a robot camera held in portrait; the renders are all upright, and a prox that learned "floor at
-  the bottom" costs on portrait frames: 0.775 -> 0.872x linear on rooms turned at test time, docs/design-notes.md).
+  crop (a phone or a robot camera held in portrait; the renders are all upright, and a prox that learned "floor at the
+  bottom" costs on portrait frames: 0.775 -> 0.872x linear on rooms turned at test time, research/README.md,
+  far_views).
   Only frames whose turned size still holds the crop are turned (a 256x320 render with 128x160 crops; not a 128x416
   street with 128x208 crops, which would have to zoom);
 - horizontal flip (geometry stays valid for a pinhole camera; the scenes have no left/right bias);
@@ -32,14 +33,14 @@ What each part is for (real sensors and real frames differ from the synthetic re
   of the RGB and nowhere in the depth (`paint_texture`): real surfaces carry print, grain and clutter that the
   renders' flat materials lack, so a prox trained on renders alone learns that every colour edge is a depth edge
   and, on real frames (e.g. Middlebury's shelves), invents depth steps at texture. Photographs have 2-3x the
-  renders' colour edges (benchmarks/edge_statistics.py: 0.24 of NYU's pixels against 0.09 of the rendered rooms');
+  renders' colour edges (research/edge_statistics.py: 0.24 of NYU's pixels against 0.09 of the rendered rooms');
   one patch raises the rooms to 0.13, three to 0.23, six to 0.34.
 - illumination: with probability `illumination_prob`, the RGB times a smooth random gain field exp(a f), f in
   [-1, 1], a in [0, illumination_strength] (`relight`): a photograph's brightness varies smoothly with its lights
   (a lamp's falloff on a wall, a window, a shadow's penumbra) without any change of depth, while the renders'
   shading follows their geometry. (It was added because the photograph costs RMSE on flat ground in the shared
-  real frames, benchmarks/failure_look.py; relighting renders at inference then changed lip-any's error by 0.3 %,
-  so smooth light is not that cost's cause: docs/design-notes.md. It stays as robustness to lighting.)
+  real frames, research/failure_look.py; relighting renders at inference then changed lip-any's error by 0.3 %,
+  so smooth light is not that cost's cause: research/README.md. It stays as robustness to lighting.)
 Ground truth is only cropped, zoomed and flipped: the model learns to undo the noise and the outliers.
 """
 from __future__ import annotations

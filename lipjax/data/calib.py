@@ -170,23 +170,38 @@ def read_odometry_calib(path: str | os.PathLike, camera: int = 2) -> tuple[Intri
     return intrinsics, rigid(translation=t) @ rigid(tr)
 
 
-def read_calibration(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
-    """(intrinsics of the camera's image, pixels; (4, 4) T_cam_from_lidar, metres) from any format of the module
-    docstring, told apart by its keys. `camera`: the KITTI camera (2 = left colour, 3 = right colour); a rig file
-    describes one camera and ignores it."""
+def calibration_format(path: str | os.PathLike) -> str:
+    """Which format of the module docstring a calibration is, told apart by its keys: "kitti-raw",
+    "kitti-object" (object and tracking), "kitti-odometry" or "rig". Raises DatasetError for a missing file or one
+    of no known format."""
     path = Path(path)
     if path.is_dir() or path.name in RAW_FILES:
-        return read_kitti_raw_calib(path if path.is_dir() else path.parent, camera)
+        return "kitti-raw"
     if not path.is_file():
         raise dataset_error(f"Calibration file not found (give {FORMATS})", path)
     if path.suffix.lower() in (".yaml", ".yml"):
-        return read_rig_calib(path)
+        return "rig"
     rows = read_key_values(path)
     if {"Tr_velo_to_cam", "Tr_velo_cam"} & rows.keys():
-        return read_kitti_object_calib(path, camera)
+        return "kitti-object"
     if "Tr" in rows:
-        return read_odometry_calib(path, camera)
+        return "kitti-odometry"
     if "T_cam_from_lidar" in rows:
-        return read_rig_calib(path)
+        return "rig"
     raise dataset_error(f"Not a calibration file of a known format: no Tr_velo_to_cam, Tr or T_cam_from_lidar; give "
                         f"{FORMATS}", path)
+
+
+def read_calibration(path: str | os.PathLike, camera: int = 2) -> tuple[Intrinsics, np.ndarray]:
+    """(intrinsics of the camera's image, pixels; (4, 4) T_cam_from_lidar, metres) from any format of the module
+    docstring, told apart by its keys (`calibration_format`). `camera`: the KITTI camera (2 = left colour, 3 = right
+    colour); a rig file describes one camera and ignores it."""
+    path = Path(path)
+    fmt = calibration_format(path)
+    if fmt == "kitti-raw":
+        return read_kitti_raw_calib(path if path.is_dir() else path.parent, camera)
+    if fmt == "kitti-object":
+        return read_kitti_object_calib(path, camera)
+    if fmt == "kitti-odometry":
+        return read_odometry_calib(path, camera)
+    return read_rig_calib(path)

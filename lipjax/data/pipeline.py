@@ -115,18 +115,14 @@ class BatchIterator:
             raise ValueError(f"sampler returned {sparse.shape} for {sample.id!r} of shape {sample.shape}")
         return sample, sparse
 
+    def examples(self, step: int) -> list[tuple[Sample, np.ndarray]]:
+        """This process's examples of global step `step`, as `example` gives them (frames of any sizes)."""
+        return [self.example(i) for i in self.local_indices(step)]
+
     def batch(self, step: int) -> Batch:
-        """This process's Batch of global step `step` (a pure function of the step)."""
-        examples = [self.example(i) for i in self.local_indices(step)]
-        shapes = {s.shape for s, _ in examples}
-        if len(shapes) > 1:
-            raise ValueError(f"examples of step {step} have different sizes {sorted(shapes)}; use a protocol")
-        return Batch(
-            rgb=np.stack([s.rgb for s, _ in examples]),
-            sparse=np.stack([y for _, y in examples]),
-            gt=np.stack([s.depth for s, _ in examples]),
-            gt_valid=np.stack([s.valid for s, _ in examples]),
-        )
+        """This process's Batch of global step `step` (a pure function of the step); its frames must share one
+        size (StepBatches crops frames of several sizes one by one)."""
+        return stacked(self.examples(step), f"step {step}")
 
     @property
     def end_step(self) -> int | None:
@@ -145,6 +141,20 @@ class BatchIterator:
             step += 1
 
 
+def stacked(examples: list[tuple[Sample, np.ndarray]], what: str = "a batch") -> Batch:
+    """A Batch of (Sample, sparse) examples of one size; a one-line ValueError names the sizes otherwise."""
+    shapes = {s.shape for s, _ in examples}
+    if len(shapes) > 1:
+        raise ValueError(f"the frames of {what} have different sizes {sorted(shapes)}; train with a crop "
+                         "(data.crop, lipjax train --crop H W) or a protocol that brings them to one size")
+    return Batch(
+        rgb=np.stack([s.rgb for s, _ in examples]),
+        sparse=np.stack([y for _, y in examples]),
+        gt=np.stack([s.depth for s, _ in examples]),
+        gt_valid=np.stack([s.valid for s, _ in examples]),
+    )
+
+
 def with_host_inputs(model_config: Any, batch: Batch) -> Batch:
     """Adds the host-computed initial estimate z0 (metres) to a (cropped) batch for models that need one: the
     model config's `host_inputs(sparse)`; None (no model) adds nothing."""
@@ -153,10 +163,21 @@ def with_host_inputs(model_config: Any, batch: Batch) -> Batch:
 
 
 def validation_batches(source: Any, model_config: Any, batch_size: int = EVAL_BATCH_SIZE) -> list[Batch]:
-    """Every frame of a Source (lipjax.data.sources) at full size, in order, with its z0: a fixed validation set."""
+    """Every frame of a Source (lipjax.data.sources) at full size, in order, with its z0: a fixed validation set.
+
+    Consecutive frames of one size share a batch of up to `batch_size`; a frame of another size starts a new one,
+    so frames of several sizes (a folder of KITTI drives: 370x1224, 375x1242, ...) are each validated whole, at
+    their own size (the metrics are per image, then averaged: the batching does not change them)."""
     it = BatchIterator(source.dataset, min(batch_size, len(source.dataset)), source.sampler, shuffle=False,
                        drop_last=False, num_epochs=1)
-    return [with_host_inputs(model_config, b) for b in it]
+    batches, run = [], []
+    for index in range(len(source.dataset)):
+        example = it.example(index)
+        if run and (len(run) == batch_size or example[0].shape != run[0][0].shape):
+            batches.append(stacked(run))
+            run = []
+        run.append(example)
+    return [with_host_inputs(model_config, b) for b in batches + [stacked(run)]]
 
 
 @dataclasses.dataclass(frozen=True)
@@ -181,7 +202,16 @@ class StepBatches:
     def __getitem__(self, step: int) -> dict[str, np.ndarray]:
         step = int(step)
         first = self.iterator.local_batch_size * self.iterator.process_index
-        batch = augment_batch(self.iterator.batch(step), self.augment, self.crop, self.seed, step, first)
+        examples = self.iterator.examples(step)
+        if self.crop is not None and len({s.shape for s, _ in examples}) > 1:
+            # frames of several sizes: each is augmented and cropped on its own, with the draws it would have in
+            # one batch (augment_batch keys them by the example's place in the global batch), then stacked
+            parts = [augment_batch(stacked([e]), self.augment, self.crop, self.seed, step, first + i)
+                     for i, e in enumerate(examples)]
+            batch = Batch(*(np.concatenate(arrays) for arrays in zip(*((p.rgb, p.sparse, p.gt, p.gt_valid)
+                                                                          for p in parts))))
+        else:
+            batch = augment_batch(stacked(examples, f"step {step}"), self.augment, self.crop, self.seed, step, first)
         return {"step": np.int64(step), **with_host_inputs(self.model_config, batch).as_dict()}
 
 

@@ -33,6 +33,7 @@ from lipjax.data.sample import Sample
 from lipjax.zbuffer import nearest_per_cell
 
 DEFAULT_SAMPLER = "uniform:200"  # the sparse input where the data have none of their own (the paper's Table I)
+OWN_INPUT = "input"  # "input" / "input:N": a data set's own sparse input, not a sampler here (lipjax.data.sources)
 
 # A noisy sample must stay > 0: 0 means "no sample" and would silently drop the point.
 MIN_SPARSE_DEPTH_M = 1e-3
@@ -460,8 +461,20 @@ def sampler_from_spec(spec: str) -> SparseSampler:
     return _single_sampler_from_spec(spec)
 
 
+def is_own_input(spec: str) -> bool:
+    """Whether `spec` is "input" or "input:N": a data set's own sparse input (lipjax.data.sources), not a sampler
+    of this module."""
+    return "|" not in spec and spec.split(":")[0].strip().lower() == OWN_INPUT
+
+
 def draws_scan_lines(spec: str) -> bool:
-    """Whether the sampler of `spec` (see `sampler_from_spec`) draws LiDAR scan lines for some examples."""
+    """Whether the sparse input of `spec` (see `sampler_from_spec`) may hold LiDAR scan lines for some examples:
+    a sampler that draws them, or a data set's own input ("input[:N]", `is_own_input`), whose pattern is the user's
+    sensor's and unknown here (a KITTI scan, a folder's sparse/ maps). A model trained on that input has seen its
+    pattern, so scan lines are no warning for it (lipjax.inference.Completer.scan_lines_trained); whether a
+    data set reads camera intrinsics for it is lipjax.data.sources.uses_intrinsics (own input: never)."""
+    if is_own_input(spec):
+        return True
     sampler = sampler_from_spec(spec)
     parts = sampler.samplers if isinstance(sampler, Mixture) else (sampler,)
     return any(isinstance(_innermost(part), LidarSampler) for part in parts)
@@ -514,6 +527,10 @@ def _single_sampler_from_spec(spec: str) -> SparseSampler:
             raise ValueError(f"sampler spec {spec!r}: unknown LiDAR option(s) {sorted(unknown)}; "
                              f"known: {sorted(fields)}")
         sampler = LIDAR_PRESETS[preset](**overrides)
+    elif kind == OWN_INPUT:
+        raise ValueError(f"sampler spec {spec!r}: 'input' is a data set's own sparse input (a folder's sparse/ "
+                         "maps, KITTI's scans), not a sampler to mix, wrap or draw on frames without one; give "
+                         "'input' or 'input:N' alone for such a data set, else a sampler such as uniform:200")
     else:
         raise ValueError(f"unknown sampler spec {spec!r}; expected uniform:N, bernoulli:N, keypoint:N, holes:F or "
                          f"lidar:{'|'.join(LIDAR_PRESETS)}")

@@ -134,7 +134,7 @@ def _upsampled_conv(low, kernel):
     The gradient is that of the same map written plainly (`_upsampled_conv_plain`, equal in exact arithmetic):
     XLA's CPU backward of the phase form (its kernel sums, the 2x2 convolution, the phase slices) took 4-8x as long
     (a training step of lip_any 2.3 s, against 0.2 s for its forward), the plain form's is an ordinary
-    convolution's (`python benchmarks/train_throughput.py --sources --models lip_any`).
+    convolution's (`python -m benchmarks.train_throughput --sources --models lip_any`).
     """
     b, h, w, _ = low.shape
     c = kernel.shape[3]

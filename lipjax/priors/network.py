@@ -25,8 +25,9 @@ Choices and why:
 - Zero-initialised residual head: an untrained G is the identity, so an untrained LIP model returns its initial
   fill with the measurements kept, instead of noise.
 - The log domain is an option for outdoor scenes, where depth spans 1-80 m: an additive residual in units of
-  max_depth must be 10x finer at 8 m than at 80 m for the same relative error (what REL and the inverse-depth
-  metrics score), and nothing stops it from crossing zero (a few thin poles did, docs/design-notes.md).
+  max_depth must be 10x finer at 8 m than at 80 m for the same relative error (what REL and the inverse-depth metrics
+  score), and nothing stops it from crossing zero (a few thin poles did,
+  docs/decisions/0003-losses-and-log-depth-prox.md).
 
 Units: v and z in metres; `max_depth_m` (10 m indoors, 80-90 m outdoors) only scales the network's inputs/outputs.
 """

@@ -10,7 +10,7 @@ Depth features (`inputs`):
 - "log_gradients": the horizontal and vertical differences of log depth between neighbouring valid pixels,
   scaled by LOG_GRADIENT_GAIN. A completion started from an interpolation differs from true depth mostly in its
   local shape (planar facets, blurred edges), not in its absolute value; differences of log depth show exactly
-  that, at every depth range alike (benchmarks/discriminator_probe.py measures what D can learn from each).
+  that, at every depth range alike (research/discriminator_probe.py measures what D can learn from each).
 """
 from __future__ import annotations
 

@@ -61,6 +61,38 @@ def default_init(**data) -> tuple[str, str, str]:
     return DEFAULT_MODELS[scene], scene, why
 
 
+def fitted_batch_size(batch_size: int, frames: int, devices: int = 1) -> int:
+    """The frames per step of a run over `frames` training frames: `batch_size` when they fill a batch of it (every
+    step is a full batch: lipjax.data.pipeline.BatchIterator drops an incomplete one), else all of them, rounded
+    down to a multiple of `devices` (each step's batch is split evenly over the devices). One-line ValueError when
+    the frames are fewer than the devices."""
+    if frames >= batch_size:
+        return batch_size
+    fitted = min(batch_size, frames) // devices * devices
+    if fitted < 1:
+        raise ValueError(f"{frames} training frame(s) make no batch of one frame for each of {devices} devices; add "
+                         "frames to the folder (or run on fewer devices)")
+    return fitted
+
+
+def own_input_validation(data: dict) -> dict:
+    """DataConfig fields over FOLDER_DATA for a run on a folder's own sparse input (train_sampler "input[:N]") that
+    names no val_sampler: validation draws the same input (the sensor the model is tuned to) where the validation
+    frames have their sparse/ maps, rather than FOLDER_DATA's uniform points, which would score the model on a
+    pattern it was not trained on (a LiDAR-tuned model validated on 200 scattered points looks worse than its
+    start). Other fields unchanged."""
+    from lipjax.data.folder import SPARSE_DIR
+    from lipjax.data.sampling import is_own_input
+    from lipjax.data.sources import folder_split_root
+
+    spec = data.get("train_sampler")
+    if spec is None or not is_own_input(spec) or data.get("val_sampler") is not None:
+        return data
+    if not (folder_split_root(Path(data["root"]), "val")[0] / SPARSE_DIR).is_dir():
+        return data
+    return {**data, "val_sampler": spec}
+
+
 def check_frames(data: DataConfig) -> int:
     """Reads every frame of a folder source once (RGB, depth, intrinsics, sizes; and sparse/ when a sampler is
     "input"), both splits, in threads. Returns the number of frames; raises one DatasetError naming every

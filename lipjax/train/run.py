@@ -3,6 +3,7 @@
     run(config, "runs/lip_cnn_nyu", export="runs/lip_cnn_nyu/model")
     soup(config, ["runs/export/a", "runs/export/b"], "runs/export/soup")   # the mean of saved models of one chain
     fine_tune_folder("my_frames", "models/mine", depth_scale=1000)   # `lipjax train`: the default model, fine-tuned
+                                                                     # (the start, should the end validate worse)
 
 Used by `python -m experiments.train` and (through `fine_tune_folder`) `lipjax train`. Nothing is written outside
 `workdir` and `export`.
@@ -25,7 +26,8 @@ from lipjax import model_io
 from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
-from lipjax.train.folder import check_frames, default_init, folder_config
+from lipjax.train.folder import check_frames, default_init, fitted_batch_size, folder_config
+from lipjax.train.folder import own_input_validation
 from lipjax.train.loop import check_same_run, data_streams, evaluate_params, export as export_model, train
 from lipjax.train.loop import validation_batches
 from lipjax.train.state import init_state
@@ -45,7 +47,7 @@ def averaged_params(config: TrainConfig, workdir: str | os.PathLike, template: A
     """Checkpoint averaging: the element-wise mean of G's parameters over the newest `count` checkpoints of the
     run in `workdir` (restored into `template`, a TrainState of the run's structure), and their steps. Late in a
     decaying schedule the checkpoints lie close together, and their mean is at least as good as the last one on
-    validation (measured: docs/training.md, lip-fast-indoor)."""
+    validation (measured: docs/decisions/0006-checkpoint-averaging-and-soups.md)."""
     manager = CheckpointManager(pathlib.Path(workdir) / "checkpoints", keep=config.keep_checkpoints)
     try:
         steps = sorted(manager.all_steps())[-count:]
@@ -110,8 +112,12 @@ def check_writable(folder: str | os.PathLike, what: str) -> None:
                       "folder") from None
 
 
+KEEPS = ("best", "last")  # what `run` exports when the end validates worse than the start: the start, or the end
+
+
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
-        export_only: bool = False, average: int = 1, progress: bool = True, validate_start: bool = False) -> dict:
+        export_only: bool = False, average: int = 1, progress: bool = True, validate_start: bool = False,
+        keep: str = "last") -> dict:
     """Trains `config` in `workdir` (resuming), then validates and, when `export` is a path, saves the model there.
     Before training, the folder of `export` must be writable (`check_writable`) and a folder source's frames
     readable (lipjax.train.folder.check_frames).
@@ -121,11 +127,15 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     mean parameters of the newest `average` checkpoints instead (`averaged_params`; their steps go into the model's
     metadata as `checkpoints`).
     validate_start: validate the starting parameters too (lipjax.train.loop.train); the last line then gives both
-    scores. Returns the validation metrics (metres).
+    scores. keep (KEEPS), when the start was validated and the end validates worse (a higher val RMSE): "best"
+    exports the starting parameters instead (`kept_start`), "last" the end; either way the last line says so.
+    Returns the validation metrics (metres) of what was exported (or trained, when nothing is).
     """
     workdir = pathlib.Path(workdir)
     if average < 1:
         raise ValueError(f"--average {average}: give a number of checkpoints >= 1")
+    if keep not in KEEPS:
+        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
     if export is not None:
         check_writable(pathlib.Path(export).parent, "the model (--out / --export)")
     if config.data.source == "folder" and not export_only:
@@ -154,12 +164,17 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         plot_curves(workdir / "metrics.jsonl", workdir / "curves.png", title=config.name)
     start = logged_validation(workdir / "metrics.jsonl", 0)
     before = f" ({start['rmse_m']:.4f} at step 0)" if start and int(state.step) > 0 else ""
+    worse = bool(before) and val["rmse_m"] > start["rmse_m"]
     if export is not None:
         d = config.data
-        export_model(config, state, export, {"val_metrics": val, "val_sampler": d.val_sampler,
-                                             "val_images": d.val_images, "data": d.kind if d.source == "synthetic"
-                                             else d.source, **averaged})
         what = f"mean of steps {averaged['checkpoints']}" if averaged else f"step {int(state.step)}"
+        meta = {"val_metrics": val, "val_sampler": d.val_sampler, "val_images": d.val_images,
+                "data": d.kind if d.source == "synthetic" else d.source, **averaged}
+        if worse and keep == "best":
+            return kept_start(config, state, export, meta, start, what)
+        export_model(config, state, export, meta)
+        if worse:
+            before = f", WORSE than {start['rmse_m']:.4f} at step 0 (the last, as asked; keep best exports the start)"
         print(f"[lipjax] exported {config.name} ({what}) to {export}: val rmse_m={val['rmse_m']:.4f}{before}")
     else:
         print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f}{before} "
@@ -167,23 +182,55 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     return val
 
 
+def kept_start(config: TrainConfig, state: Any, export: str | os.PathLike, meta: dict, start: dict,
+               what: str) -> dict:
+    """Exports the starting parameters of a run whose end (`state`, `what` in words, validation meta["val_metrics"])
+    validates worse than its start (`start`: step 0's validation metrics), and says so in one line; returns
+    `start`. The model records the start's budget (step 0: no image of this run), its training input
+    (`train_sampler` of the model it started from) and validation, `kept`: "start", and the end it was kept over
+    (`kept_over`: which, and its validation)."""
+    if config.init_from:
+        params, init_meta = model_io.load(config.init_from)[1], model_io.metadata(config.init_from)
+    else:  # the run's own random start (init_state is a function of the config's seed)
+        params, init_meta = init_state(config).g_params, {}
+    end = meta["val_metrics"]
+    meta = {**meta, "val_metrics": start, "train_sampler": init_meta.get("train_sampler"),
+            "kept": "start", "kept_over": {"model": what, "val_metrics": end}}
+    export_model(config, state.replace(g_params=params, step=np.zeros((), np.int32)), export, meta)
+    print(f"[lipjax] exported {config.name} (its start: {what} validated worse, rmse_m={end['rmse_m']:.4f}; "
+          f"keep last exports it) to {export}: val rmse_m={start['rmse_m']:.4f}")
+    return start
+
+
 def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str | None = None,
                      steps: int | None = None, batch_size: int | None = None, workdir: str | os.PathLike | None = None,
-                     progress: bool = True, log: Callable[[str], None] | None = None, **data: Any) -> dict:
+                     progress: bool = True, log: Callable[[str], None] | None = None, keep: str = "best",
+                     **data: Any) -> dict:
     """`lipjax train`: fine-tunes a model on a folder of RGB-D frames (lipjax.train.folder) and exports it to
     `out` (a model path stem, also the run's name).
 
     Args:
       init: the model to start from (name or path); None: the default model of the frames' scene
         (lipjax.train.folder.default_init), named with its reason to `log` (a callable taking a line) if given.
-      steps: training steps, batch_size: frames per step (None: folder_config's FOLDER_STEPS, FOLDER_BATCH_SIZE).
+      steps: training steps, batch_size: frames per step (None: folder_config's FOLDER_STEPS, FOLDER_BATCH_SIZE);
+        a folder of fewer training frames trains on all of them per step (lipjax.train.folder.fitted_batch_size),
+        said in one line to `log`.
       workdir: checkpoints and logs (default runs/train-<out name>).
+      keep: "best" exports the starting model's parameters when the end validates worse than the start, "last"
+        the end regardless; either way the last line says so (`run`).
       data: DataConfig fields over lipjax.train.folder.FOLDER_DATA (depth_scale, crop, train_sampler, num_workers);
-        None keeps FOLDER_DATA's.
+        None keeps FOLDER_DATA's. Frames of several sizes train through the crop (each frame is cropped before
+        batching) and validate whole, each at its own size (lipjax.data.pipeline). train_sampler "input[:N]" (the
+        folder's sparse/ maps) validates on the same input unless val_sampler is given
+        (lipjax.train.folder.own_input_validation).
 
-    Returns the validation metrics (metres), as `run`.
+    Returns the validation metrics (metres) of the exported model, as `run`.
     """
-    data = {"root": os.fspath(root), **{k: v for k, v in data.items() if v is not None}}
+    from lipjax.data.sources import open_source
+
+    data = own_input_validation({"root": os.fspath(root), **{k: v for k, v in data.items() if v is not None}})
+    if keep not in KEEPS:
+        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
     if init is None:
         init, scene, why = default_init(**data)
         if log is not None:
@@ -191,4 +238,10 @@ def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: s
     name = pathlib.Path(out).name
     config = folder_config(model_io.load(init)[0], init, name=name, **data)
     config = dataclasses.replace(config, **{k: v for k, v in (("g_steps", steps), ("batch_size", batch_size)) if v})
-    return run(config, workdir or f"runs/train-{name}", export=out, progress=progress, validate_start=True)
+    frames, asked = len(open_source(config.data, "train").dataset), config.batch_size
+    if frames < asked:
+        config = dataclasses.replace(config, batch_size=fitted_batch_size(asked, frames, jax.device_count()))
+        if log is not None:
+            log(f"batch size {config.batch_size}: the folder's {frames} training frame(s) fill no batch of {asked}; "
+                "add frames for larger batches")
+    return run(config, workdir or f"runs/train-{name}", export=out, progress=progress, validate_start=True, keep=keep)

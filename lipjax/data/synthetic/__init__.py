@@ -56,7 +56,7 @@ Approximations made for speed (all deterministic): shadow rays are cast for one 
 outdoors, objects wholly farther than 70 m cast no shadow; the sky is shaded at 1/4 resolution; objects
 covering fewer than 32 pixels get their material's mean colour instead of the full texture.
 
-Speed (`taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py --frames 40`, one pinned core of the 2-CPU
+Speed (`taskset -c 0 .venv/bin/python -m benchmarks.synthetic_fps --frames 40`, one pinned core of the 2-CPU
 development machine with the training jobs paused): frames/s of CPU time, 256x320: indoor 30.4 (val split,
 unpinned: 27.8), outdoor 25.0 (val: 21.7); 128x160: indoor 55, outdoor 31-34. With a training job beside it
 (load ~5): outdoor 256x320 20-22. Outdoor frames cost more: ~140 primitives against ~30 indoors.

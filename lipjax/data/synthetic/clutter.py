@@ -2,11 +2,11 @@
 
 The rendered rooms are tidy (furniture along the walls, a few things on its tops, open floor); photographed rooms
 are not (boxes, bags, bins, chairs and toys on the floor, close to the camera), and real rooms have about 1.7x the
-renders' depth-edge pixels (docs/design-notes.md). `add_clutter(scene, rng)` adds `ClutterRanges.objects` things to a
-built room, each on the floor at a distance and bearing drawn inside the camera's horizontal view: boxes (some
-stacked), cylinders (bins, buckets, stools), balls, and the tabletop things of `furniture._small_object` scaled
-up. Its draws come from `rng` alone, after the room is built, so a room with clutter is the same room with more
-in it. Units: metres and radians.
+renders' depth-edge pixels (research/README.md, edge_statistics; docs/decisions/0010-clutter-in-training-rooms.md).
+`add_clutter(scene, rng)` adds `ClutterRanges.objects` things to a built room, each on the floor at a distance and
+bearing drawn inside the camera's horizontal view: boxes (some stacked), cylinders (bins, buckets, stools), balls, and
+the tabletop things of `furniture._small_object` scaled up. Its draws come from `rng` alone, after the room is built,
+so a room with clutter is the same room with more in it. Units: metres and radians.
 """
 from __future__ import annotations
 

@@ -2,8 +2,8 @@
 
 A rendered room is closed (every depth within ~11 m); a photograph of a room often is not: windows, open doors
 and glass walls show buildings and trees tens of metres away, and a sparse sensor samples them as it samples the
-walls. A prox trained on closed rooms takes such samples for outliers (`python benchmarks/far_views.py`: the
-228,000-image lip-any, 0.781x linear on 12 closed test rooms, is 1.014x with their windows; docs/design-notes.md).
+walls. A prox trained on closed rooms takes such samples for outliers (`python -m research.far_views`: the
+228,000-image lip-any, 0.781x linear on 12 closed test rooms, is 1.014x with their windows; research/README.md).
 `add_far_view` pastes a rectangle of a street render into a room render of the same size:
 
     (t, l, h, w)   the window in the room: h / H in WINDOW_HEIGHT, w / W in WINDOW_WIDTH, t / H in WINDOW_TOP
