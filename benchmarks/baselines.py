@@ -2,9 +2,9 @@
 
 Run by hand (never a test):
 
-    .venv/bin/python benchmarks/baselines.py [--limit N] [--json out.json] [--realdata ../shared/realdata]
-                                             [--skip-synthetic] [--skip-real] [--methods nearest,linear,...]
-                                             [--max-side N]
+    python -m benchmarks.baselines [--limit N] [--json out.json] [--realdata ../shared/realdata]
+                                   [--skip-synthetic] [--skip-real] [--methods nearest,linear,...]
+                                   [--max-side N]
 
 Data sets (each a Markdown table: rows = methods, columns = metrics with units, lipjax.metrics):
   synthetic indoor test split, 256x320, 200 uniform points (UniformSampler(200)), depth range (0, 10] m;
@@ -32,94 +32,16 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import re
 import sys
 import time
 
-import cv2
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
-from lipjax.data import protocols  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.classical.lip_wavelet import LIPWavelet  # noqa: E402
-from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
-from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json  # noqa: E402
-
-INDOOR_RANGE_M = (0.0, protocols.EVAL_MAX_DEPTH_INDOOR_M)
-OUTDOOR_RANGE_M = (0.0, protocols.EVAL_MAX_DEPTH_OUTDOOR_M)
-
-def _rgb(path: str) -> np.ndarray:
-    bgr = cv2.imread(path, cv2.IMREAD_COLOR)
-    if bgr is None:
-        raise FileNotFoundError(path)
-    return np.ascontiguousarray(bgr[:, :, ::-1])
-
-
-def _png_depth(path: str, scale: float) -> np.ndarray:
-    raw = cv2.imread(path, cv2.IMREAD_UNCHANGED)
-    if raw is None or raw.dtype != np.uint16:
-        raise ValueError(f"{path}: expected a uint16 depth PNG")
-    return raw.astype(np.float32) / scale  # 0 stays 0 = invalid
-
-
-def read_pfm(path: str) -> np.ndarray:
-    """A grey-scale PFM as float32 (H, W), top row first."""
-    with open(path, "rb") as f:
-        if f.readline().strip() != b"Pf":
-            raise ValueError(f"{path}: not a grey-scale PFM")
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        data = np.fromfile(f, dtype="<f4" if scale < 0 else ">f4", count=w * h)
-    return np.flipud(data.reshape(h, w)).astype(np.float32)  # PFM rows are stored bottom-up
-
-
-def load_nyu(root: str) -> list[Sample]:
-    """NYU v2 frames: depth PNG / 1000 = metres; standard NYU RGB intrinsics (PROVENANCE.md)."""
-    k = Intrinsics(518.8579, 519.46961, 325.58245, 253.73617)
-    out = []
-    for name in sorted(os.listdir(os.path.join(root, "rgb"))):
-        idx = re.findall(r"\d+", name)[-1]
-        rgb = _rgb(os.path.join(root, "rgb", name))
-        depth = _png_depth(os.path.join(root, "depth", f"sync_depth_{idx}.png"), 1000.0)
-        out.append(Sample.from_depth(rgb, depth, k, f"realdata/nyu_v2/{idx}"))
-    return out
-
-
-def load_kitti(root: str) -> list[Sample]:
-    """KITTI frames: depth PNG / 256 = metres. Intrinsics: the 2011_09_26 P_rect_02 that matches the
-    1242x375 size (the json's 2011_09_28 values are doubtful, see PROVENANCE.md)."""
-    k = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
-    out = []
-    for name in sorted(os.listdir(os.path.join(root, "rgb"))):
-        rgb = _rgb(os.path.join(root, "rgb", name))
-        depth = _png_depth(os.path.join(root, "depth", name), 256.0)
-        out.append(Sample.from_depth(rgb, depth, k, f"realdata/kitti/{os.path.splitext(name)[0]}"))
-    return out
-
-
-def load_middlebury(root: str) -> list[Sample]:
-    """Middlebury 2014 Motorcycle (quarter size): Z [mm] = baseline * f / (d + doffs); inf disparity = unknown."""
-    calib = dict(line.strip().split("=", 1) for line in open(os.path.join(root, "calib.txt")) if "=" in line)
-    cam0 = [float(v) for v in re.findall(r"[-\d.]+", calib["cam0"])]
-    f, cx, cy = cam0[0], cam0[2], cam0[5]
-    doffs, baseline_mm = float(calib["doffs"]), float(calib["baseline"])
-    disp = read_pfm(os.path.join(root, "disp0GT.pfm"))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        depth_m = np.where(np.isfinite(disp), baseline_mm * f / (disp + doffs) / 1000.0, 0.0)
-    rgb = _rgb(os.path.join(root, "im0.png"))
-    return [Sample.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy),
-                              "realdata/middlebury/motorcycle")]
-
-
-def load_real(root: str) -> tuple[list[Sample], list[Sample], list[Sample]]:
-    """The real frames under `root` as the benchmarks score them: NYU v2 (protocol nyu_paper), KITTI (kitti_paper),
-    Middlebury (full size)."""
-    nyu = [protocols.NYU_PAPER(s) for s in load_nyu(os.path.join(root, "nyu_v2"))]
-    kitti = [protocols.KITTI_PAPER(s) for s in load_kitti(os.path.join(root, "kitti"))]
-    return nyu, kitti, load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
-
+from benchmarks.common import INDOOR_RANGE_M, OUTDOOR_RANGE_M, REALDATA, load_real
+from experiments.configs import OUTDOOR_DATA  # the outdoor evaluation size, 128x416
+from lipjax.classical.lip_wavelet import LIPWavelet
+from lipjax.evaluate import DEFAULT_COLUMNS, evaluate, markdown_table, save_json
+from lipjax.methods import get_completer
 
 # ------------------------------------------------------------------------------------------- runner
 
@@ -187,7 +109,7 @@ def per_frame_table(results: dict, reference: str) -> str:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--limit", type=int, default=None, help="frames per synthetic split (default: all 200)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--json", default=None, help="write all results (with per-image metrics) to this file")
     ap.add_argument("--skip-synthetic", action="store_true")
     ap.add_argument("--skip-real", action="store_true")

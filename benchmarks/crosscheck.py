@@ -1,29 +1,24 @@
 """The default path with and without its check against the linear fill (lipjax.crosscheck), on synthetic frames.
 
-    python benchmarks/crosscheck.py [--model lip-any] [--frames 8] [--json OUT] [--only TEXT]
+    python -m benchmarks.crosscheck [--model lip-any] [--frames 8] [--json OUT] [--only TEXT]
 
 The settings of benchmarks/generalisation.py that the check applies to (100 or more scattered samples; the scan-line
 settings are unchanged by construction), and two where the model does not fit its input: lip-fast-outdoor (trained
-on streets only) on rooms at 480x640 with 200 points, and --model on rooms with dense depth with holes
-(`holes:0.3`; dense maps are not checked since rule 49 of docs/design-notes.md, so both columns are equal
-there). Per setting: the geometric-mean RMSE ratio to the Delaunay linear fill of the plain path
-(`cross_check=False`) and of the checked one, and their wins. The rule that adopted the check, and its numbers:
-docs/design-notes.md, "A check against the linear fill".
+on streets only) on rooms at 480x640 with 200 points, and --model on rooms with dense depth with holes (`holes:0.3`;
+dense maps are not checked (docs/decisions/0016-dense-input-not-checked.md), so both columns are equal there). Per
+setting: the geometric-mean RMSE ratio to the Delaunay linear fill of the plain path (`cross_check=False`) and of the
+checked one, and their wins. The rules that adopted the check, and their numbers: docs/decisions/0013 to 0016.
 """
 from __future__ import annotations
 
 import argparse
 import json
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.generalisation import ROOM, SETTINGS, frames, ratio_to_linear  # noqa: E402
-from lipjax.crosscheck import MIN_SAMPLES  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import ROOM, SETTINGS, frames, ratio_to_linear
+from lipjax.crosscheck import MIN_SAMPLES
+from lipjax.methods import get_completer
 
 
 def main(argv=None) -> None:

@@ -2,7 +2,7 @@
 
 Run by hand (never a test):
 
-    python benchmarks/folder_speed.py [--frames 100] [--model NAME] [--repeats 5] [--threads N] [--keep DIR]
+    python -m benchmarks.folder_speed [--frames 100] [--model NAME] [--repeats 5] [--threads N] [--keep DIR]
 
 Writes --frames synthetic KITTI-size frames (outdoor test renders at 352x1216 with the HDL-64 scan pattern,
 lipjax.data.synthetic.render and lipjax.data.sampling.LidarSampler.hdl64) into a temporary folder as KITTI ships
@@ -27,7 +27,6 @@ import io
 import os
 import re
 import statistics
-import sys
 import tempfile
 import time
 from pathlib import Path
@@ -35,14 +34,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from lipjax.data.folder import read_frame  # noqa: E402
-from lipjax.data.sampling import LidarSampler  # noqa: E402
-from lipjax.data.synthetic import render  # noqa: E402
-from lipjax.cli import main as lipjax_main  # noqa: E402
-from lipjax.inference import complete_frame, frame_size  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.utils import enable_compilation_cache, limit_cpu_threads  # noqa: E402
+from lipjax.data.folder import read_frame
+from lipjax.data.sampling import LidarSampler
+from lipjax.data.synthetic import render
+from lipjax.cli import main as lipjax_main
+from lipjax.inference import complete_frame, frame_size
+from lipjax.methods import get_completer
+from lipjax.utils import enable_compilation_cache, limit_cpu_threads
 
 HEIGHT, WIDTH, PNG_SCALE = 352, 1216, 256.0
 

@@ -1,6 +1,6 @@
 """Writes docs/gallery.png: synthetic indoor and outdoor frames (RGB, depth, sparse input).
 
-Run by hand:  .venv/bin/python benchmarks/gallery.py [--out docs/gallery.png] [--split val] [--start 0] [--n 4]
+Run by hand:  python -m benchmarks.gallery [--out docs/gallery.png] [--split val] [--start 0] [--n 4]
 
 Depth uses one fixed colour range per kind (indoor 0-10 m, outdoor 0-80 m), invalid pixels (sky, beyond
 80 m) black. The sparse input is drawn with lipjax.data.sampling (indoor: 200 uniform points; outdoor: an
@@ -10,18 +10,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from lipjax.data import synthetic  # noqa: E402
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.interfaces import SCENE_MAX_DEPTH_M  # noqa: E402
+from lipjax.data import synthetic
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.interfaces import SCENE_MAX_DEPTH_M
 
 MAX_DEPTH_M = {"indoor": SCENE_MAX_DEPTH_M["indoor"], "outdoor": synthetic.RENDER_FAR_CLIP_M}
 

@@ -4,7 +4,7 @@ The model's own estimate is scored (`cross_check=False`, `mirror=False`): the de
 linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its mirror image on scan lines
 (lipjax.inference.mirrors) a second estimate.
 
-    python benchmarks/initial_fill.py [--model lip-any] [--frames 4]
+    python -m benchmarks.initial_fill [--model lip-any] [--frames 4]
 
 For synthetic test renders (never trained on) with sparse and dense inputs, the model runs through the default path
 (`lipjax.inference.complete_frame`, at its working size) twice: with z_0 the linear fill and with z_0 the nearest
@@ -16,18 +16,15 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import Completer, complete_frame, frame_size, reproject_sparse  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.resolution import sample_spacing_px  # noqa: E402
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.inference import Completer, complete_frame, frame_size, reproject_sparse
+from lipjax.methods import get_completer
+from lipjax.resolution import sample_spacing_px
 
 SETTINGS = (
     ("indoor", 480, 640, "uniform:200"),

@@ -1,6 +1,6 @@
 """Synthetic streets scored where KITTI's ground truth would lie: near the LiDAR's own scan lines.
 
-    python benchmarks/kitti_like_gt.py [--model lip-any] [--frames 24] [--start 8] [--sampler lidar:hdl64]
+    python -m benchmarks.kitti_like_gt [--model lip-any] [--frames 24] [--start 8] [--sampler lidar:hdl64]
                                        [--figure docs/results/kitti_like_gt.png]
 
 KITTI's depth ground truth is LiDAR too: 11 sweeps accumulated around each frame, so its valid pixels lie near
@@ -12,27 +12,23 @@ Delaunay linear fill, on the unsampled pixels:
   - the KITTI-like mask: the union of SWEEPS HDL-64 patterns, the LiDAR from FORWARD_M[0] to FORWARD_M[1] metres
     ahead of the camera and pitched PITCH_DEG[0] to PITCH_DEG[1] degrees, azimuth steps of AZIMUTH_STEP_DEG
     (about half the synthetic test pixels).
-It prints each frame's two ratios to linear and their geometric means (< 1: the model wins). docs/design-notes.md,
-rule 46, says why it was written and what it decided. `--figure` draws the first street: the image, the KITTI-like
-mask, and where the default path's squared error exceeds linear's (red) or falls below it (blue) on that mask,
-with and without the samples' residuals spread (`lipjax.spread`).
+It prints each frame's two ratios to linear and their geometric means (< 1: the model wins).
+docs/decisions/0018-residual-spreading.md says why it was written and what it decided. `--figure` draws the first
+street: the image, the KITTI-like mask, and where the default path's squared error exceeds linear's (red) or falls
+below it (blue) on that mask, with and without the samples' residuals spread (`lipjax.spread`).
 """
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import numpy as np
 from tqdm import tqdm
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.generalisation import STREET, geometric_mean  # noqa: E402
-from lipjax.data.sampling import LidarSampler, sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_at, complete_frame, frame_size  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import STREET, geometric_mean
+from lipjax.data.sampling import LidarSampler, sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.inference import complete_at, complete_frame, frame_size
+from lipjax.methods import get_completer
 
 SWEEPS = 11  # KITTI accumulates 11 LiDAR sweeps around each frame
 FORWARD_M = (-0.27, 5.0)  # the accumulated sweeps' LiDAR positions ahead of the camera (KITTI mounts it 0.27 m behind)
@@ -86,7 +82,8 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", default="lip-any", help="a shipped model's name or an exported model's path")
     parser.add_argument("--frames", type=int, default=24)
-    parser.add_argument("--start", type=int, default=8, help="the first test street (rule 46 prototyped on 0-7)")
+    parser.add_argument("--start", type=int, default=8,
+                        help="the first test street (residual spreading was prototyped on 0-7)")
     parser.add_argument("--sampler", default="lidar:hdl64", help="the input pattern (lipjax.data.sampling spec)")
     parser.add_argument("--figure", help="draw the first street to this PNG (module docstring)")
     args = parser.parse_args(argv)

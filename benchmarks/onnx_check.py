@@ -2,8 +2,8 @@
 
 Run by hand (never a test; needs onnxruntime):
 
-    python benchmarks/onnx_check.py [--model NAME] [--realdata ../shared/realdata] [--out DIR]
-    python benchmarks/onnx_check.py --scattered [--model NAME] [--frames 5]
+    python -m benchmarks.onnx_check [--model NAME] [--realdata ../shared/realdata] [--out DIR]
+    python -m benchmarks.onnx_check --scattered [--model NAME] [--frames 5]
 
 Default: the KITTI frames under --realdata (read here, never copied into the repository), cropped to 352x1216 as
 the depth-completion selection (protocol kitti_selection), the HDL-64 pattern drawn on their ground truth as
@@ -23,18 +23,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.baselines import load_kitti  # noqa: E402
-from lipjax.data.protocols import KITTI_SELECTION  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.methods import complete, get_completer  # noqa: E402
-from lipjax.onnx_export import export_onnx, nearest_twin  # noqa: E402
-from lipjax.shipped import DEFAULT_MODELS  # noqa: E402
+from benchmarks.common import REALDATA, load_kitti
+from lipjax.data.protocols import KITTI_SELECTION
+from lipjax.data.sampling import LidarSampler, UniformSampler
+from lipjax.methods import complete, get_completer
+from lipjax.onnx_export import export_onnx, nearest_twin
+from lipjax.shipped import DEFAULT_MODELS
 
 
 def _session(path: str):
@@ -92,7 +90,7 @@ def scattered(model: str, frames: int, out: str) -> None:
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", help="default: the default outdoor model (KITTI), indoor (--scattered)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--scattered", action="store_true")
     ap.add_argument("--frames", type=int, default=5, help="--scattered: rooms of the test split")
     ap.add_argument("--out", help="folder for the .onnx files (default: a temporary one)")

@@ -2,8 +2,8 @@
 
 Run by hand (never a test):
 
-    .venv/bin/python benchmarks/prox_speed.py [--height 256] [--width 320] [--iterations 3] [--repeats 20]
-                                              [--models lip-fast-indoor,...]
+    python -m benchmarks.prox_speed [--height 256] [--width 320] [--iterations 3] [--repeats 20]
+                                    [--models lip-fast-indoor,...]
 
 Rows: the paper-style prox (lipjax.priors.network "small" and "paper" presets) and the shared-encoder prox
 (lipjax.priors.guided "fast"), each as a K-iteration LIP model started from the linear fill (as the shipped
@@ -22,38 +22,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
-import sys
-import time
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-
-from lipjax.inference import Completer, compiled_apply, load_model  # noqa: E402
-from lipjax.model import LIPConfig  # noqa: E402
-from lipjax.priors.guided import PRESETS as GUIDED_PRESETS  # noqa: E402
-from lipjax.priors.network import network_preset  # noqa: E402
-
-
-def _median_ms(fn, repeats: int) -> float:
-    fn()
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return 1e3 * statistics.median(times)
-
-
-def matmul_rate(repeats: int) -> tuple[float, float]:
-    """(ms, GFLOP/s) of a 2048x2048 float32 matmul on the default device."""
-    a = jnp.asarray(np.random.default_rng(0).random((2048, 2048), np.float32))
-    f = jax.jit(lambda x: x @ x)
-    ms = _median_ms(lambda: f(a).block_until_ready(), repeats)
-    return ms, 2 * 2048**3 / (ms * 1e-3) / 1e9
+from benchmarks.common import matmul_rate, median_ms
+from lipjax.inference import Completer, compiled_apply, load_model
+from lipjax.model import LIPConfig
+from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
+from lipjax.priors.network import network_preset
 
 
 def _frame(height: int, width: int, samples: int = 200):
@@ -73,9 +51,9 @@ def measure(completer: Completer, rgb: np.ndarray, sparse: np.ndarray, repeats: 
     compiled = run.lower(*args).compile()  # one compilation serves the flop count and the solver timing
     cost = compiled.cost_analysis()
     cost = cost[0] if isinstance(cost, (list, tuple)) else cost
-    solver = _median_ms(lambda: jax.block_until_ready(compiled(*args)), repeats)
-    fill = _median_ms(lambda: config.host_inputs(sparse[None]), repeats) if extra else 0.0
-    total = _median_ms(lambda: completer(rgb, sparse), repeats)
+    solver = median_ms(lambda: jax.block_until_ready(compiled(*args)), repeats)
+    fill = median_ms(lambda: config.host_inputs(sparse[None]), repeats) if extra else 0.0
+    total = median_ms(lambda: completer(rgb, sparse), repeats)
     return {"params_M": config.parameter_count(params) / 1e6, "gflop": cost.get("flops", float("nan")) / 1e9,
             "solver_ms": solver, "fill_ms": fill, "total_ms": total, "fps": 1e3 / total}
 

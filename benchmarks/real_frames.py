@@ -1,10 +1,12 @@
-"""Per-frame RMSE ratios to a linear fill on the 15 shared real frames, at native size, through the default path.
+"""Per-frame RMSE ratios to a linear fill on the 15 shared real frames, at native size, through the default path;
+and on the KITTI frames, the scores near the samples: at LiDAR points hidden from the input.
 
 Run by hand (never a test; the frames are research-use data read from ../shared/realdata, never copied):
 
-    python benchmarks/real_frames.py [--model NAME] [--realdata ../shared/realdata] [--json out.json]
+    python -m benchmarks.real_frames [--model NAME] [--realdata ../shared/realdata] [--json out.json]
                                      [--mirror | --no-mirror] [--sweep]
                                      [--plot docs/results/real_frames_working_res.png]
+    python -m benchmarks.real_frames --hidden-only [--model NAME] [--json out.json]   # the KITTI checks alone
 
 Frames at their native size: NYU v2 (3, 480x640), KITTI (3, 375x1242), Middlebury 2014 Motorcycle (1, 497x741),
 lingbot (8, 480x640, raw consumer RGB-D depth). Inputs drawn from the valid ground truth with seed 0 and the frame
@@ -19,54 +21,48 @@ ip_basic and colorization. `--model` scores one model through the same path inst
 only) for the model and its grey run, `--no-mirror` on none.
 `--sweep` also runs the model at several target sample spacings (lipjax.resolution, with its pixel cap) and at the
 native size ("full"), and plots the geometric-mean ratio against the working resolution.
+
+Near the samples (issue 55: "never worse than linear"), on the 3 KITTI frames with their HDL-64 input, three checks
+of the default path (`lipjax.complete`, with `--model` and `--mirror` as above), `linear` and `ip_basic`, each as RMSE
+and MAE (m) and the default path's ratio to linear:
+
+    dense ground truth   the whole input; scored on the unsampled valid ground-truth pixels (the table above)
+    hidden points        HIDDEN_FRACTION (20 %) of the input's points, drawn at random by
+                         `example_rng(0, frame id, "hidden")` (seed 0), removed from the input; the rest (80 %)
+                         completed, scored on the hidden points alone (their depth: the ground truth there)
+    hidden beams         every HIDDEN_BEAM_EVERY-th (4th) scan line of the input removed: the beams present in the
+                         input ranked from the top (highest elevation) down, ranks 3, 7, 11, ... hidden, never the
+                         lowest beam, so each hidden line lies between two kept ones; scored on its points alone
+
+The input carries no beam labels, so `beam_index` derives them from the geometry that drew them: every input point
+is back-projected with the frame's intrinsics into the LiDAR frame of LidarSampler.hdl64 (KITTI's mount), and its
+elevation is binned to the nearest of the 64 beam elevations (LidarSampler.angles and the rounding of
+LidarSampler.__call__): the sampler keeps only pixels within half a beam spacing of a beam, so the labels are
+exactly the beams that drew the points.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import os
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.baselines import _png_depth, _rgb, load_kitti, load_middlebury, load_nyu  # noqa: E402
-from lipjax.data.sample import Intrinsics, Sample  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.inference import complete_at, complete_frame, frame_size  # noqa: E402
-from lipjax.inputs import is_lidar_pattern  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
+from benchmarks.common import GREY, REALDATA, frames_and_inputs, geometric_mean, load_kitti
+from lipjax.data.sample import Sample
+from lipjax.data.sampling import LidarSampler, example_rng
+from lipjax.inference import complete_at, complete_frame, frame_size
+from lipjax.inputs import is_lidar_pattern
+from lipjax.methods import complete, get_completer
+from lipjax.resolution import sample_spacing_px, working_size
 
-KITTI_FRACTION = 0.3  # of the valid pixels, the second KITTI input
-INDOOR_POINTS = 200
-GREY = 128
 SWEEP_TARGETS_PX = (6.0, 8.0, 11.0, 16.0, 22.0, 32.0, 1e9)
-
-
-def load_lingbot(root: str) -> list[Sample]:
-    """lingbot frames: depth PNG / 1000 = metres (raw sensor depth), a 3x3 K per frame (PROVENANCE.md)."""
-    out = []
-    for name in sorted(os.listdir(os.path.join(root, "rgb"))):
-        stem = os.path.splitext(name)[0]
-        k = np.loadtxt(os.path.join(root, "intrinsics", f"{stem}.txt")).reshape(3, 3)
-        depth = _png_depth(os.path.join(root, "depth", f"{stem}.png"), 1000.0)
-        out.append(Sample.from_depth(_rgb(os.path.join(root, "rgb", name)), depth,
-                                     Intrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2]), f"realdata/lingbot/{stem}"))
-    return out
-
-
-def frames_and_inputs(root: str) -> list[tuple[str, Sample, np.ndarray, str]]:
-    """(group, sample, sparse input metres, input name) for every frame and input setting."""
-    indoor = load_nyu(os.path.join(root, "nyu_v2")) + load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
-    indoor += load_lingbot(os.path.join(root, "lingbot_rgbd"))
-    out = [("indoor", s, UniformSampler(INDOOR_POINTS)(s, 0), f"{INDOOR_POINTS} points") for s in indoor]
-    for s in load_kitti(os.path.join(root, "kitti")):
-        out.append(("kitti-hdl64", s, LidarSampler.hdl64()(s, 0), "HDL-64"))
-        n = int(round(KITTI_FRACTION * np.count_nonzero(s.valid)))
-        out.append(("kitti-30pct", s, UniformSampler(n)(s, 0), f"30 % ({n} points)"))
-    return out
+KITTI_LIDAR = LidarSampler.hdl64()  # the KITTI input's pattern (frames_and_inputs)
+HIDDEN_FRACTION = 0.2  # of the input's points, hidden at random
+HIDDEN_BEAM_EVERY = 4  # every 4th scan line hidden
+HIDDEN_METHODS = ("linear", "ip_basic")
+CHECKS = ("dense ground truth", "hidden points", "hidden beams")
 
 
 def rmse(pred: np.ndarray, sample: Sample, sparse: np.ndarray) -> float:
@@ -80,21 +76,155 @@ def summary(ratios: list[float]) -> str:
     return f"wins {int((r < 1).sum())}/{len(r)}, median {np.median(r):.3f}, geometric mean {gm:.3f}"
 
 
+def beam_index(sample: Sample, sparse: np.ndarray, sampler: LidarSampler = KITTI_LIDAR) -> np.ndarray:
+    """(H, W) int64: the beam (0 = the lowest) that drew each input point of `sparse`, -1 where there is none.
+
+    As `sampler` draws them: the valid ground-truth pixel back-projected into the LiDAR frame (LidarSampler.angles),
+    its elevation rounded to the nearest beam elevation. The sampler keeps a pixel only within half a beam spacing
+    of a beam, so every input point gets the beam that drew it."""
+    idx, elevation, _, _ = sampler.angles(sample)
+    beams = np.radians(sampler.beam_elevations_deg())
+    spacing = (beams[-1] - beams[0]) / (sampler.beams - 1)
+    label = np.full(sparse.size, -1, np.int64)
+    label[idx] = np.clip(np.rint((elevation - beams[0]) / spacing), 0, sampler.beams - 1)
+    label = np.where(sparse.reshape(-1) > 0, label, -1).reshape(sparse.shape)
+    if np.any((sparse > 0) & (label < 0)):
+        raise ValueError(f"{sample.id}: input points off the valid ground truth, so off the sampler's pixels")
+    return label
+
+
+def hide_points(sample: Sample, sparse: np.ndarray, fraction: float = HIDDEN_FRACTION,
+                seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(input without the hidden points, hidden mask): round(fraction x points) of the input's points, drawn by
+    `example_rng(seed, sample.id, "hidden")`."""
+    idx = np.flatnonzero(sparse > 0)
+    chosen = example_rng(seed, sample.id, "hidden").choice(idx, int(round(fraction * idx.size)), replace=False)
+    hidden = np.zeros(sparse.size, bool)
+    hidden[chosen] = True
+    hidden = hidden.reshape(sparse.shape)
+    return np.where(hidden, 0.0, sparse).astype(np.float32), hidden
+
+
+def hide_beams(beams: np.ndarray, sparse: np.ndarray,
+               every: int = HIDDEN_BEAM_EVERY) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """(input without the hidden beams, hidden mask, beams in the input, beams hidden): the beams present ranked
+    from the top down, ranks every-1, 2 every-1, ... hidden, the lowest beam never (each hidden line lies between
+    two kept ones)."""
+    present = np.unique(beams[beams >= 0])[::-1]  # the highest elevation first
+    hidden_beams = present[every - 1:-1:every]
+    hidden = np.isin(beams, hidden_beams) & (sparse > 0)
+    return np.where(hidden, 0.0, sparse).astype(np.float32), hidden, len(present), len(hidden_beams)
+
+
+def errors(pred: np.ndarray, sample: Sample, mask: np.ndarray) -> tuple[float, float]:
+    """(RMSE, MAE) in metres of `pred` against the ground truth on `mask`."""
+    e = pred[mask] - sample.depth[mask]
+    return float(np.sqrt(np.mean(e ** 2))), float(np.mean(np.abs(e)))
+
+
+def hidden_checks(kitti: list[tuple[Sample, np.ndarray]], model, mirror) -> list[dict]:
+    """The checks near the samples (module docstring) on each (KITTI frame, its HDL-64 input): one row per frame
+    and check, with (RMSE, MAE) of "default" and of each of HIDDEN_METHODS."""
+    methods = [get_completer(m) for m in HIDDEN_METHODS]
+    rows = []
+    for sample, sparse in kitti:
+        beams = beam_index(sample, sparse)
+        kept, hidden, n_beams, n_hidden = hide_beams(beams, sparse)
+        inputs = {"dense ground truth": (sparse, sample.valid & (sparse <= 0), ""),
+                  "hidden points": (*hide_points(sample, sparse), ""),
+                  "hidden beams": (kept, hidden, f"{n_hidden} of {n_beams} beams")}
+        for check, (given, mask, note) in inputs.items():
+            completer = get_completer(model, sparse=given)
+            row = {"frame": sample.id, "check": check, "input_points": int((given > 0).sum()),
+                   "scored_points": int(mask.sum()), "note": note, "model": completer.name,
+                   "working_size": list(frame_size(completer, given)),
+                   "default": errors(complete(sample.rgb, given, model, mirror=mirror), sample, mask)}
+            for m in methods:
+                row[m.name] = errors(m(sample.rgb, given), sample, mask)
+            rows.append(row)
+            print(f"{sample.id:24s} {check:19s} {note:16s} input {row['input_points']:6d} scored "
+                  f"{row['scored_points']:6d}  " + "  ".join(
+                      f"{n} {row[n][0]:.3f}/{row[n][1]:.3f} m" for n in ("default", *HIDDEN_METHODS)), flush=True)
+    return rows
+
+
+def hidden_table(rows: list[dict]) -> None:
+    """The checks near the samples as a Markdown table, and per check the geometric means over the frames."""
+    other = [m for m in HIDDEN_METHODS if m != "linear"]
+    paths = sorted({f"{r['model']} at {r['working_size'][0]}x{r['working_size'][1]}" for r in rows})
+    print(f"\ndefault path (lipjax.complete): {', '.join(paths)}; RMSE and MAE in metres on the scored points\n")
+    print("| frame | check | input points | scored points | default RMSE m | linear RMSE m | RMSE ratio | "
+          "default MAE m | linear MAE m | MAE ratio | " + " | ".join(f"{m} RMSE m | {m} MAE m" for m in other) + " |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|" + "---:|---:|" * len(other))
+    for r in rows:
+        d, lin = r["default"], r["linear"]
+        check = r["check"] + (f" ({r['note']})" if r["note"] else "")
+        print(f"| {r['frame'].removeprefix('realdata/')} | {check} | {r['input_points']} | {r['scored_points']} | "
+              f"{d[0]:.3f} | {lin[0]:.3f} | {d[0] / lin[0]:.3f} | {d[1]:.3f} | {lin[1]:.3f} | {d[1] / lin[1]:.3f} | "
+              + " | ".join(f"{r[m][0]:.3f} | {r[m][1]:.3f}" for m in other) + " |")
+    print("\nPer check, over the KITTI frames: geometric mean of the ratio to linear (wins: frames below 1)\n")
+    print("| check | default RMSE | default MAE | " + " | ".join(f"{m} RMSE | {m} MAE" for m in other) + " |")
+    print("|---|---:|---:|" + "---:|---:|" * len(other))
+    for check in CHECKS:
+        chosen = [r for r in rows if r["check"] == check]
+        cells = []
+        for name in ("default", *other):
+            for k in (0, 1):
+                ratios = [r[name][k] / r["linear"][k] for r in chosen]
+                cells.append(f"{geometric_mean(ratios):.3f} (wins {sum(x < 1 for x in ratios)}/{len(ratios)})")
+        print(f"| {check} | " + " | ".join(cells) + " |")
+
+
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
-    ap.add_argument("--json", default=None)
+    ap.add_argument("--realdata", default=REALDATA)
+    ap.add_argument("--json", default=None,
+                    help="write the rows here (with --hidden-only: the rows of the checks near the samples)")
     ap.add_argument("--mirror", action=argparse.BooleanOptionalAction,
                     help="the path with (--mirror) or without (--no-mirror) mirror averaging on every input")
     ap.add_argument("--sweep", action="store_true", help="also sweep the working resolution")
     ap.add_argument("--plot", default=None, help="with --sweep: write the ratio-vs-resolution picture here")
     ap.add_argument("--classical", default="ip_basic,colorization", help="comma-separated classical methods")
+    ap.add_argument("--hidden-only", action="store_true",
+                    help="only the KITTI checks near the samples (hidden points, hidden beams), not the 15 frames")
     args = ap.parse_args(argv)
+    root = os.path.abspath(args.realdata)
+    if args.hidden_only:
+        print("Near the samples: the KITTI frames with their HDL-64 input")
+        hidden = hidden_checks([(s, KITTI_LIDAR(s, 0)) for s in load_kitti(os.path.join(root, "kitti"))],
+                               args.model, args.mirror)
+        hidden_table(hidden)
+        _write_json(args.json, hidden)
+        return
+    inputs = frames_and_inputs(root)
+    rows = frame_rows(inputs, args)
+    frames_table(rows, [m for m in args.classical.split(",") if m])
+    if args.sweep:
+        sweep_table(rows, args.plot)
+    print("\nNear the samples: the KITTI frames with their HDL-64 input")
+    hidden = hidden_checks([(s, sparse) for group, s, sparse, _ in inputs if group == "kitti-hdl64"],
+                           args.model, args.mirror)
+    hidden_table(hidden)
+    for r in rows:  # the checks ride on their frame's HDL-64 row
+        if r["group"] == "kitti-hdl64":
+            r["near_samples"] = [h for h in hidden if h["frame"] == r["frame"]]
+    _write_json(args.json, rows)
 
+
+def _write_json(path: str | None, doc) -> None:
+    if path:
+        with open(path, "w") as f:
+            json.dump(doc, f, indent=1)
+        print(f"\nwrote {path}")
+
+
+def frame_rows(inputs, args) -> list[dict]:
+    """One row per (frame, input) of `frames_and_inputs`: RMSE ratios to linear of the default path, its grey run
+    and the --classical methods (and the --sweep)."""
     linear, classical = get_completer("linear"), [get_completer(m) for m in args.classical.split(",") if m]
     rows = []
-    for group, sample, sparse, input_name in frames_and_inputs(os.path.abspath(args.realdata)):
+    for group, sample, sparse, input_name in inputs:
         completer = get_completer(args.model, sparse=sparse)
         grey = np.full_like(sample.rgb, GREY)
         ref = rmse(linear(sample.rgb, sparse), sample, sparse)
@@ -116,8 +246,12 @@ def main(argv=None) -> None:
         print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "
               + "  ".join(f"{m.name} {row[m.name]:.3f}" for m in classical) + f"  {ms:.0f} ms", flush=True)
+    return rows
 
-    names = ["default", "grey"] + [m.name for m in classical]
+
+def frames_table(rows: list[dict], classical: list[str]) -> None:
+    """The per-frame table of RMSE ratios to linear, and the summaries over the 15 frames."""
+    names = ["default", "grey"] + classical
     print("\n| frame | input | model | working size | linear RMSE m | " + " | ".join(names) + " |")
     print("|---|---|---|---|---|" + "---|" * len(names))
     for r in rows:
@@ -130,13 +264,6 @@ def main(argv=None) -> None:
             print(f"  {n:14s} {summary([r[n] for r in chosen])}")
         worth = np.exp(np.mean([np.log(r["grey"]) for r in chosen]) - np.mean([np.log(r["default"]) for r in chosen]))
         print(f"  image's worth (geometric-mean RMSE grey / RGB): {worth:.3f}")
-    if args.sweep:
-        sweep_table(rows, args.plot)
-    if args.json:
-        with open(args.json, "w") as f:
-            json.dump(rows, f, indent=1)
-        print(f"\nwrote {args.json}")
-
 
 def _sweep_size(shape: tuple[int, int], spacing: float, target: float, scan_lines: bool) -> tuple[int, int]:
     """The working size with target spacing `target` (and the pixel cap of the pattern); >= 1e9: the native size."""

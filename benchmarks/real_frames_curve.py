@@ -2,8 +2,8 @@
 
 Run by hand (never a test; the real frames are research-only and stay in ../shared/realdata):
 
-    .venv/bin/python benchmarks/real_frames_curve.py --model RUN=PATH [--model RUN=PATH ...]
-                                                    [--out curve.png] [--json out.json]
+    python -m benchmarks.real_frames_curve --model RUN=PATH [--model RUN=PATH ...]
+                                          [--out curve.png] [--json out.json]
 
 Each PATH is a saved model (lipjax.model_io stem, or a shipped name) whose metadata records `images_seen`; models
 with the same RUN label are one training run, drawn as one line. The frames and sparse inputs are those of
@@ -22,15 +22,12 @@ import argparse
 import json
 import math
 import os
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-sys.path.insert(0, os.path.dirname(__file__))
-from baselines import INDOOR_RANGE_M, OUTDOOR_RANGE_M, load_real  # noqa: E402
-from lipjax import model_io  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.evaluate import evaluate  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import INDOOR_RANGE_M, OUTDOOR_RANGE_M, REALDATA, load_real
+from lipjax import model_io
+from lipjax.data.sampling import LidarSampler, UniformSampler
+from lipjax.evaluate import evaluate
+from lipjax.methods import get_completer
 
 
 def real_settings(root: str) -> list[tuple[list, object, tuple[float, float]]]:
@@ -79,7 +76,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--model", action="append", required=True, metavar="RUN=PATH",
                     help="a saved model and the run it belongs to (repeat)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--out", default=None, help="write the plot here (PNG)")
     ap.add_argument("--json", default=None, help="write the rows here")
     args = ap.parse_args(argv)

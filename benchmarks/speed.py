@@ -2,7 +2,7 @@
 
 Run by hand (never a test):
 
-    python benchmarks/speed.py [--models default,unchecked:default,onnx:default,lip-fast-indoor]
+    python -m benchmarks.speed [--models default,unchecked:default,onnx:default,lip-fast-indoor]
                                [--classical linear,nearest,ip_basic,colorization] [--repeats 5]
 
 Frames: synthetic test renders (the test split, never trained on) at 256x320 and 480x640 with 200 uniform points
@@ -26,19 +26,17 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import tempfile
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.prox_speed import _median_ms, matmul_rate  # noqa: E402
-from lipjax.data.sampling import HolesSampler, LidarSampler, UniformSampler  # noqa: E402
-from lipjax.data.synthetic import render  # noqa: E402
-from lipjax.inference import complete_frame, frame_size  # noqa: E402
-from lipjax.inputs import is_lidar_pattern  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.onnx_export import export_onnx  # noqa: E402
+from benchmarks.common import matmul_rate, median_ms
+from lipjax.data.sampling import HolesSampler, LidarSampler, UniformSampler
+from lipjax.data.synthetic import render
+from lipjax.inference import complete_frame, frame_size
+from lipjax.inputs import is_lidar_pattern
+from lipjax.methods import get_completer
+from lipjax.onnx_export import export_onnx
 
 REFERENCE_GFLOPS = 195.0  # the rate the issues normalise frames/s to
 SIZES = (("room 256x320, 200 pts", "indoor", 256, 320, UniformSampler(200)),
@@ -68,7 +66,7 @@ def main(argv=None) -> None:
         cells = []
         for _, rgb, sparse in frames:
             run, label = _runner(name, rgb, sparse)
-            ms = _median_ms(run, args.repeats)
+            ms = median_ms(run, args.repeats)
             cells.append(f"{ms:.0f} ({1e3 / ms * REFERENCE_GFLOPS / rate:.1f}){label}")
         print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
 

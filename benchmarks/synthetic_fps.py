@@ -2,7 +2,7 @@
 
 Run by hand (not a test); pin to one core so the number means "per core":
 
-    taskset -c 0 .venv/bin/python benchmarks/synthetic_fps.py [--frames 40] [--split train]
+    taskset -c 0 python -m benchmarks.synthetic_fps [--frames 40] [--split train]
 
 Prints frames/s for indoor and outdoor at 256x320 and 128x160: mean over `--frames` consecutive indices
 (different scenes) after 2 warm-up frames, whole `render()` calls (scene building, ray casting, shading,
@@ -15,15 +15,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 
 # numpy's elementwise work is single-threaded anyway; keep any BLAS pool from spreading over cores.
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(var, "1")
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from lipjax.data import synthetic  # noqa: E402
+from lipjax.data import synthetic
 
 SIZES = ((256, 320), (128, 160))
 

@@ -1,7 +1,7 @@
 """Training throughput: input pipeline frames/s per source and worker count, host cost per frame, train-step rate.
 
-    python benchmarks/train_throughput.py [--steps 12] [--workers 1 2] [--models lip_cnn_indoor lip_fast_indoor ...]
-    python benchmarks/train_throughput.py --sources --models lip_any     # the train step alone
+    python -m benchmarks.train_throughput [--steps 12] [--workers 1 2] [--models lip_cnn_indoor lip_fast_indoor ...]
+    python -m benchmarks.train_throughput --sources --models lip_any     # the train step alone
 
 1. Pipeline: frames/s of lipjax.data.pipeline.TrainLoader (reading, sparse sampling, augment + crop and the host
    z0 fill, all in the grain worker processes) for each source, with each worker count. Real formats are written
@@ -13,7 +13,7 @@
 3. Train step: images/s of the jitted supervised step of each named config at batch 8 on its training crop
    (compilation not timed), on this machine's JAX backend.
 Everything uses the configs' own samplers and initial fills (lip_cnn_indoor: z0 = linear fill on the host).
-The first line gives the machine's 2048x2048 matmul rate, measured in the same run (benchmarks/prox_speed.py).
+The first line gives the machine's 2048x2048 matmul rate, measured in the same run (benchmarks.common.matmul_rate).
 """
 from __future__ import annotations
 
@@ -186,7 +186,7 @@ def main() -> None:
     from lipjax.utils import enable_compilation_cache
 
     enable_compilation_cache()
-    from prox_speed import matmul_rate  # this folder's inference benchmark: the same matmul yardstick
+    from benchmarks.common import matmul_rate  # the inference benchmarks' matmul yardstick
 
     print(f"machine: {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f} at start; 2048x2048 float32 "
           f"matmul {matmul_rate(10)[1]:.0f} GFLOP/s (divide rates by it to compare machines or loads)")

@@ -2,8 +2,8 @@
 
 Run by hand (never a test):
 
-    .venv/bin/python benchmarks/uncertainty.py [--limit N] [--realdata ../shared/realdata] [--skip-real]
-    .venv/bin/python benchmarks/uncertainty.py --calibrate [--limit N]     # refit the constants on VAL splits
+    python -m benchmarks.uncertainty [--limit N] [--realdata ../shared/realdata] [--skip-real]
+    python -m benchmarks.uncertainty --calibrate [--limit N]     # refit the constants on VAL splits
 
 Completions: `linear` and the shipped `lip-cnn-indoor` / `lip-cnn-outdoor` (lipjax.methods), each frame's sparse
 input drawn from its ground truth with seed 0 (lipjax.data.sampling). Settings: the synthetic TEST splits (indoor
@@ -24,19 +24,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 
 import numpy as np
 from scipy.stats import spearmanr
 
-sys.path.insert(0, os.path.dirname(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from baselines import INDOOR_RANGE_M, OUTDOOR_RANGE_M, load_kitti, load_middlebury, load_nyu  # noqa: E402
-from experiments.configs import OUTDOOR_DATA  # noqa: E402  (the outdoor evaluation size, 128x416)
-from lipjax import uncertainty  # noqa: E402
-from lipjax.data import protocols  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import INDOOR_RANGE_M, OUTDOOR_RANGE_M, REALDATA, load_kitti, load_middlebury, load_nyu
+from experiments.configs import OUTDOOR_DATA  # the outdoor evaluation size, 128x416
+from lipjax import uncertainty
+from lipjax.data import protocols
+from lipjax.data.sampling import LidarSampler, UniformSampler
+from lipjax.methods import get_completer
 
 
 def synthetic_settings(split: str, limit: int):
@@ -117,7 +114,7 @@ def calibrate(settings, method_names):
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--limit", type=int, default=20, help="frames per synthetic split (the first N)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--skip-real", action="store_true")
     ap.add_argument("--calibrate", action="store_true", help="fit the constants on the synthetic val splits")
     ap.add_argument("--methods", default="linear,lip-cnn-{scene}",

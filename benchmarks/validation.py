@@ -2,8 +2,8 @@
 
 Run by hand (not a test):
 
-    .venv/bin/python benchmarks/validation.py --scene indoor    # 32 val frames 256x320, uniform:200
-    .venv/bin/python benchmarks/validation.py --scene outdoor   # 32 val frames 128x416, lidar:hdl64
+    python -m benchmarks.validation --scene indoor    # 32 val frames 256x320, uniform:200
+    python -m benchmarks.validation --scene outdoor   # 32 val frames 128x416, lidar:hdl64
 
 The frames, sizes and sampler are those of the scene's training config (experiments/configs/, `data.val_*`),
 so this is the table behind "the shipped weights beat LIP+Wavelet and every classical baseline on the synthetic
@@ -13,18 +13,15 @@ validation split". Metrics per image over valid ground truth in the scene protoc
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from experiments.common import evaluate_methods  # noqa: E402
-from experiments.configs import CONFIGS  # noqa: E402
-from lipjax.data.protocols import get_protocol  # noqa: E402
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.evaluate import markdown_table  # noqa: E402
-from lipjax.methods import available_methods  # noqa: E402
-from lipjax.utils import enable_compilation_cache  # noqa: E402
+from experiments.common import evaluate_methods
+from experiments.configs import CONFIGS
+from lipjax.data.protocols import get_protocol
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.evaluate import markdown_table
+from lipjax.methods import available_methods
+from lipjax.utils import enable_compilation_cache
 
 COLUMNS = ("rmse_m", "mae_m", "rel", "delta1_pct", "irmse_1_per_km", "mae_sampled_m", "ms_per_frame")
 

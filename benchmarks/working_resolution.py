@@ -4,7 +4,7 @@ The model's own estimate is scored (`cross_check=False`, `mirror=False`): the de
 linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its mirror image on scan lines
 (lipjax.inference.mirrors) a second estimate.
 
-    python benchmarks/working_resolution.py [--model lip-fast-indoor] [--frames 12] [--out runs/eval/working_res]
+    python -m benchmarks.working_resolution [--model lip-fast-indoor] [--frames 12] [--out runs/eval/working_res]
 
 Rooms rendered at 480x640 (NYU's size) and streets at 352x1216 (KITTI's), from the test split (never trained on),
 with 50, 200, 1,000 and 5,000 uniform points on the rooms, and 64- and 32-beam scans, 200 points or 25,000 points
@@ -24,18 +24,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_at  # noqa: E402
-from lipjax.inputs import is_lidar_pattern  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-from lipjax.resolution import sample_spacing_px, working_size  # noqa: E402
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.inference import complete_at
+from lipjax.inputs import is_lidar_pattern
+from lipjax.methods import get_completer
+from lipjax.resolution import sample_spacing_px, working_size
 
 SETTINGS = (  # (kind, height, width, sampler spec)
     ("indoor", 480, 640, "uniform:50"),

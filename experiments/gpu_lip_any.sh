@@ -1,6 +1,6 @@
 #!/bin/bash
 # One run of lip-any's chain in a fixed time on a GPU host with many cores (a lent 16-core H200), from the repository
-# root (docs/training.md, runs 45 and 47):
+# root (docs/training.md, "How the shipped models were trained"):
 #
 #   INIT=experiments/warm_starts/lip-any-next SEED=45 OUT=/tmp/out [WHEELS=DIR] [BUDGET_S=585] [STEPS=N] \
 #       bash experiments/gpu_lip_any.sh

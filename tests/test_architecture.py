@@ -5,7 +5,10 @@
 * no function longer than `MAX_FUNCTION_LINES`;
 * a thin command line: lipjax/cli.py at most `MAX_CLI_LINES` lines, each `_cmd_*` at most `MAX_COMMAND_LINES`
   (it passes its arguments to one library function, where the logic lives and is tested);
-* the library never imports `experiments` (the shipped configs depend on the library, not the other way round);
+* the library never imports `experiments`, `benchmarks` or `research` (they depend on the library, not the other
+  way round);
+* benchmarks/ and research/ are packages run as `python -m benchmarks.NAME`: no sys.path edits, and a script
+  imports no other script, only the shared `benchmarks.common` (and `research.common`);
 * a private name (`_x`) is imported only from a module of the importer's own package;
 * the layers of ARCHITECTURE.md: a module imports only modules of its own layer or of layers below it;
 * every line of Python in `PYTHON_FOLDERS` shorter than `MAX_COLUMNS` columns.
@@ -21,7 +24,8 @@ MAX_FUNCTION_LINES = 100
 MAX_CLI_LINES = 300
 MAX_COMMAND_LINES = 20
 MAX_COLUMNS = 120  # lines shorter than this
-PYTHON_FOLDERS = ("lipjax", "experiments", "benchmarks", "tests")
+PYTHON_FOLDERS = ("lipjax", "experiments", "benchmarks", "research", "tests")
+SCRIPT_PACKAGES = ("benchmarks", "research")  # run as python -m PACKAGE.NAME
 
 # The layers of ARCHITECTURE.md, bottom up: module-name prefix -> layer. The longest matching prefix decides.
 LAYERS = {
@@ -182,8 +186,28 @@ def test_library_never_imports_experiments_or_benchmarks():
     for path in sorted(PACKAGE.rglob("*.py")):
         tree = ast.parse(path.read_text(), str(path))
         names = [n for node in ast.walk(tree) for n in _imported(_module_name(path), path, node, {})]
-        found += [f"{path.relative_to(ROOT)}: {n}" for n in names if n.split(".")[0] in ("experiments", "benchmarks")]
+        found += [f"{path.relative_to(ROOT)}: {n}" for n in names
+                  if n.split(".")[0] in ("experiments",) + SCRIPT_PACKAGES]
     assert found == []
+
+
+def test_benchmarks_and_research_are_packages_whose_scripts_share_only_common():
+    """`python -m benchmarks.NAME` from the repository root finds lipjax, experiments and benchmarks.common without
+    editing sys.path; a script that needs another's helper takes it from benchmarks.common (or research.common)."""
+    found = []
+    modules = {_module_name(p): p for package in SCRIPT_PACKAGES for p in (ROOT / package).rglob("*.py")}
+    scripts = {name.split(".")[-1] for name in modules} - {"__init__", "common"} - set(SCRIPT_PACKAGES)
+    for package in SCRIPT_PACKAGES:
+        assert (ROOT / package / "__init__.py").is_file(), f"{package}/ is not a package"
+        for path in sorted((ROOT / package).rglob("*.py")):
+            source, rel = path.read_text(), path.relative_to(ROOT)
+            found += [f"{rel}: edits sys.path"] if "sys.path" in source else []
+            for node in ast.walk(ast.parse(source, str(path))):
+                names = _imported(_module_name(path), path, node, modules)
+                found += [f"{rel}: imports {n}" for n in names
+                          if n.split(".")[0] in scripts or (n.split(".")[0] in SCRIPT_PACKAGES
+                                                            and n.split(".")[1:2] not in ([], ["common"]))]
+    assert found == [], "\n".join(found)
 
 
 def test_private_names_stay_inside_their_package():

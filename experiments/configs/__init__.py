@@ -7,8 +7,8 @@
     python -m experiments.train --config lip_cnn_nyu --set data.root=DIR --export runs/lip_cnn_nyu/model   # real data
 
 Families: paper.py (LIP+CNN, LIP+AD and the end-to-end baselines on the synthetic scenes), fast.py (the shipped
-shared-encoder models and lip-any), real.py (NYU v2, KITTI DC, TartanAir, your folder). Nothing is exported unless
---export PATH is given. How the shipped weights were trained: docs/training.md.
+fast-prox models and lip-any), real.py (NYU v2, KITTI DC, TartanAir, your folder). Nothing is exported unless --export
+PATH is given. How the shipped weights were trained: docs/training.md.
 """
 from __future__ import annotations
 

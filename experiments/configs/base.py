@@ -2,7 +2,8 @@
 
 A base holds what its scene needs (data, model, loss) and the synthetic LIP+CNN schedule; a named config
 (experiments/configs/paper.py, fast.py, real.py) changes the run: its name, model variant, data source, budget.
-Why each choice was made, and the runs behind it: docs/training.md, "Run history from experiments/configs.py".
+Why each choice was made, and the runs behind it: docs/decisions/ and docs/training.md, "How the shipped models were
+trained" (the run history: `git log -p -- docs/training.md`).
 """
 from __future__ import annotations
 
@@ -63,12 +64,12 @@ MIXED_SAMPLER = "|".join((
 ))
 # Zoom 0.5 shows whole 256x320 frames at half scale (KITTI-size streets at their working size); texture on one
 # rectangle and camera noise against the renders' clean, flat surfaces, and light that follows no geometry
-# (docs/design-notes.md, "RGB guidance from renders to photographs"). The reference cameras only. Runs 7-12 trained
-# with texture on up to 6 rectangles and focal lengths 0.7-1.4x the reference: from the shipped model, 44,000 images
-# of that recipe came to 0.7814 on benchmarks/generalisation.py (run 10), 44,320 of this one to 0.7723 (run 14, with
-# the parallax patterns too; docs/training.md).
+# (research/README.md: edge_statistics, nuisances). The reference cameras only. Runs 7-12 trained with texture on up to
+# 6 rectangles and focal lengths 0.7-1.4x the reference: from the shipped model, 44,000 images of that recipe came to
+# 0.7814 on `python -m benchmarks.generalisation` (run 10), 44,320 of this one to 0.7723 (run 14, with the parallax
+# patterns too; runs in git: `git log -p -- docs/training.md`).
 # Rooms with a window onto a street (lipjax.data.synthetic.far_view): a closed room never shows a far sample, and the
-# prox learned to reject them (docs/design-notes.md, "Far views inside rooms").
+# prox learned to reject them (research/README.md, far_views).
 MIXED_FAR_VIEW_PROB = 0.3
 MIXED_DATA = dataclasses.replace(
     INDOOR_DATA, kind="mixed", train_sampler=MIXED_SAMPLER, val_sampler="uniform:200|lidar:hdl64",

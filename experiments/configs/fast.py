@@ -1,8 +1,9 @@
-"""The shipped default models: the shared-encoder prox (lipjax.priors.guided "fast") on pre-rendered scenes, its
+"""The shipped default models: the fast prox (shared-encoder; lipjax.priors.guided "fast") on pre-rendered scenes, its
 LIP+AD, and lip-any for rooms and streets; each one `dataclasses.replace` of its scene base (base.py).
 
 The prox has a third of the paper-style G's FLOPs per frame and trains ~2.7x faster here, so it trains longer for
-the same CPU time. The runs (commands, overrides, curves): docs/training.md, "Run history from experiments/configs.py".
+the same CPU time. The runs (commands, overrides, curves): docs/training.md, "How the shipped models were trained" (the
+run history: `git log -p -- docs/training.md`).
 
     lipjax data render --kind indoor --split train --count 12000 --out runs/data/indoor-train-256x320
     python -m experiments.train --config lip_fast_indoor --set data.source=rendered \\
@@ -20,7 +21,7 @@ from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 
 # Scattered points plus 64- and 16-beam LiDAR scan lines on the rooms: a prox trained on scan lines as well beats
-# linear interpolation on more real frames (docs/design-notes.md, "Scan lines on rooms").
+# linear interpolation on more real frames (docs/results.md, "The same models on real frames").
 FAST_INDOOR_SAMPLER = INDOOR_DATA.train_sampler + "|lidar:hdl64,azimuth_step_deg=0.4|lidar:vlp16,azimuth_step_deg=0.4"
 FAST_INDOOR_DATA = dataclasses.replace(INDOOR_DATA, augment=DEFAULT_AUGMENT, train_sampler=FAST_INDOOR_SAMPLER)
 # Zoom >= 1 only outdoors: the renders are no taller than the crop (lipjax.data.augment).
@@ -56,7 +57,8 @@ LIP_AD_FAST_OUTDOOR = dataclasses.replace(
 LIP_ANY = dataclasses.replace(
     MIXED, name="lip-any", init_from="lip-any", g_steps=4000, learning_rate=1e-4, warmup_steps=100,
     eval_every=500, checkpoint_every=250, keep_checkpoints=40,
-    loss="log_rmse",  # the per-image log RMSE the suites score (docs/training.md, rule 45); L1 until 676,000 images
+    # the per-image log RMSE the suites score (docs/decisions/0009-log-rmse-loss.md); L1 until 676,000 images
+    loss="log_rmse",
 )
 
 CONFIGS: dict[str, TrainConfig] = {
@@ -136,5 +138,5 @@ EXPECTED: dict[str, Expected] = {
              "last checkpoint and the sixty-eighth's), the seventieth (seed 70, 1,524,640, the same soup), the "
              "seventy-first (seed 71, 1,548,640, the mean of its last 4) and the seventy-second from that (seed 72): "
              "1,572,640 images, the soup of its last checkpoint and the seventy-first's, shipped by the rules of "
-             "docs/training.md (its runs 27-72)"),
+             "docs/decisions/0008-lip-any-ship-check.md (its runs 27-72: `git log -p -- docs/training.md`)"),
 }

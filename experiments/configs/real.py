@@ -5,8 +5,8 @@ Each run reads its frames from --set data.root=DIR:
     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
 
 No weights of these configs are shipped. GPU runtimes are estimates at 400 training images/s at 256x320 (scaled by
-pixel count), which needs the grain loader with ~16 workers; protocols and runtimes in full: docs/training.md,
-"Run history from experiments/configs.py".
+pixel count), which needs the grain loader with ~16 workers; protocols and sources: docs/training.md,
+"Data sources" (the estimates are in this module).
 """
 from __future__ import annotations
 

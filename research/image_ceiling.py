@@ -5,11 +5,11 @@ The model's own estimate is scored (`cross_check=False`): the default path's che
 
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
-    python benchmarks/image_ceiling.py [--model NAME] [--synthetic 8] [--variants grey,shading,...]
-                                       [--realdata ../shared/realdata] [--json OUT]
+    python -m research.image_ceiling [--model NAME] [--synthetic 8] [--variants grey,shading,...]
+                                     [--realdata ../shared/realdata] [--json OUT]
 
 On the renders the photograph is worth about 16 % to the default model (RMSE with a grey image / with the
-photograph), on the shared real frames about 1 % (docs/design-notes.md). Either the prox cannot read photographs,
+photograph), on the shared real frames about 1 % (research/README.md). Either the prox cannot read photographs,
 or a real room gives the image less to add. This feeds the same 200 samples with six images and gives each RMSE
 ratio to the Delaunay linear fill, default path at native size (`complete_frame`):
 
@@ -17,7 +17,7 @@ ratio to the Delaunay linear fill, default path at native size (`complete_frame`
     grey         uniform grey (GREY): the depth-only part of the prior
     edges        an image made from the ground truth, the renders' cleanest cue: light grey, with the depth edges
                  drawn dark (the pixels either side of a log-depth step: central difference over DEPTH_EDGE per
-                 pixel along x or y, both ends valid, as benchmarks/failure_look.py classes them): where the
+                 pixel along x or y, both ends valid, as research/failure_look.py classes them): where the
                  surfaces break, nothing else
     shading      an image from the ground truth: a grey, uniformly white world lit by one light from the
                  camera's upper left (LIGHT_DIR, camera frame), Lambertian: AMBIENT + (1 - AMBIENT) max(0, n . l),
@@ -39,20 +39,17 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 
 import cv2
 import numpy as np
 from scipy import ndimage
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.edge_statistics import DEPTH_EDGE, log_depth_step  # noqa: E402
-from benchmarks.generalisation import geometric_mean, ratios_to_linear  # noqa: E402
-from benchmarks.real_frames import GREY, INDOOR_POINTS, frames_and_inputs  # noqa: E402
-from lipjax.classical import nearest_fill  # noqa: E402
-from lipjax.data.sampling import UniformSampler  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import GREY, INDOOR_POINTS, REALDATA, frames_and_inputs, geometric_mean, ratios_to_linear
+from lipjax.classical import nearest_fill
+from lipjax.data.sampling import UniformSampler
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.methods import get_completer
+from research.common import DEPTH_EDGE, log_depth_step
 
 MEAN_SHIFT_SP, MEAN_SHIFT_SR = 12, 24  # cv2.pyrMeanShiftFiltering's spatial (px) and colour (0-255) windows
 EDGE_GREY, BACKGROUND_GREY = 40, 200
@@ -105,7 +102,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--synthetic", type=int, default=8, help="test renders of rooms (480x640)")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--variants", default=",".join(VARIANTS), help="comma-separated, from " + ", ".join(VARIANTS))
     ap.add_argument("--json", default=None)
     args = ap.parse_args(argv)

@@ -2,7 +2,7 @@
 
 Run by hand (never a test):
 
-    .venv/bin/python benchmarks/discriminator_probe.py [--model lip-ad-indoor] [--steps 400] [--train 128] [--val 64]
+    python -m research.discriminator_probe [--model lip-ad-indoor] [--steps 400] [--train 128] [--val 64]
 
 G is frozen (the model given); its outputs on `--train` synthetic indoor train crops and `--val` val crops
 (128x160, 200 uniform samples) are computed once. Each D variant then trains alone (Adam, batch 8, the
@@ -13,23 +13,19 @@ D's ability from the adversarial game: a D that cannot beat chance here gives G 
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import jax
 import jax.numpy as jnp
 import numpy as np
 import optax
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-
-from lipjax.data.augment import Augment, augment_batch  # noqa: E402
-from lipjax.data.pipeline import BatchIterator  # noqa: E402
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.train.discriminator import Discriminator  # noqa: E402
-from lipjax.inference import compiled_apply, load_model  # noqa: E402
-from lipjax.train.losses import discriminator_loss  # noqa: E402
+from lipjax.data.augment import Augment, augment_batch
+from lipjax.data.pipeline import BatchIterator
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.train.discriminator import Discriminator
+from lipjax.inference import compiled_apply, load_model
+from lipjax.train.losses import discriminator_loss
 
 CROP = (128, 160)
 BATCH = 8

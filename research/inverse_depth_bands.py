@@ -1,6 +1,6 @@
 """Where the inverse-depth error (iRMSE) of each method comes from, split by true depth. Run by hand (not a test):
 
-    .venv/bin/python benchmarks/inverse_depth_bands.py --scene outdoor --methods lip-cnn-outdoor,colorization,nearest
+    python -m research.inverse_depth_bands --scene outdoor --methods lip-cnn-outdoor,colorization,nearest
 
 On the scene's synthetic validation split (the frames and sampler of benchmarks/validation.py), for each depth band
 of the ground truth: its share of the valid pixels, and each method's share of the summed squared inverse-depth
@@ -11,17 +11,14 @@ near or below zero depth, which alone can dominate iRMSE, do not hide where the 
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
-from experiments.configs import CONFIGS  # noqa: E402
-from lipjax.data.protocols import get_protocol  # noqa: E402
-from lipjax.data.sampling import sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from experiments.configs import CONFIGS
+from lipjax.data.protocols import get_protocol
+from lipjax.data.sampling import sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.methods import get_completer
 
 BAND_EDGES_M = (0.0, 3.0, 5.0, 8.0, 12.0, 20.0, 40.0, 80.0)
 

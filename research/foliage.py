@@ -1,27 +1,23 @@
-"""Does a model do worse on streets whose trees are porous? Rule 40 (docs/design-notes.md, "Porous foliage").
+"""Does a model do worse on streets whose trees are porous?
 
-    python benchmarks/foliage.py [--model NAME] [--frames 8] [--min-changed 0.02]
+    python -m research.foliage [--model NAME] [--frames 8] [--min-changed 0.02]
 
 Renders test streets at 352x1216 twice, with the trees and bushes as built (solid spheres) and porous
 (lipjax.data.synthetic.foliage.porous_foliage, drawn by `foliage_rng("test", i)`), keeps the first `--frames`
 streets (index order) where the porous version changes the depth of at least `--min-changed` of the pixels, draws
 the HDL-64 pattern (seed 0) on each, and prints the model's RMSE ratio to the Delaunay linear fill on both (the
 default path at its working size, without the cross-check, as model suites are compared), per frame and as
-geometric means.
+geometric means. Its result: docs/decisions/0011-porous-foliage-in-training-streets.md.
 """
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.generalisation import geometric_mean, ratio_to_linear  # noqa: E402
-from lipjax.data.synthetic.dataset import foliage_rng, render_with_info  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import geometric_mean, ratio_to_linear
+from lipjax.data.synthetic.dataset import foliage_rng, render_with_info
+from lipjax.methods import get_completer
 
 SIZE = (352, 1216)
 PATTERN = "lidar:hdl64"

@@ -3,7 +3,7 @@
 The model's own estimate is scored (`cross_check=False`): the default path's check against the linear fill
 (lipjax.crosscheck) would mix that fill into what is measured here.
 
-    python benchmarks/sensor_offset.py [--model PATH] [--frames 8]
+    python -m research.sensor_offset [--model PATH] [--frames 8]
 
 Frames of the synthetic test split (never trained on), through the default path at full size
 (`lipjax.inference.complete_frame`), each once with the samples drawn at the camera (as every other benchmark) and
@@ -20,17 +20,13 @@ seed 0) and the wins, at the camera and from the sensor beside it.
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.generalisation import ratio_to_linear  # noqa: E402
-from lipjax.data.sampling import LidarSampler, Parallax, sampler_from_spec  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import ratio_to_linear
+from lipjax.data.sampling import LidarSampler, Parallax, sampler_from_spec
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.methods import get_completer
 
 KITTI_LIDAR_M = (0.06, -0.08, -0.27)  # Velodyne from KITTI's left colour camera (x right, y down, z forward)
 RGBD_DEPTH_SENSOR_M = (0.05, 0.0, 0.0)

@@ -3,7 +3,7 @@
 The model's own estimate is scored (`cross_check=False`): the default path's check against the linear fill
 (lipjax.crosscheck) would mix that fill into what is measured here.
 
-    python benchmarks/far_views.py [--model PATH] [--frames 12] [--points 200] [--size 480x640]
+    python -m research.far_views [--model PATH] [--frames 12] [--points 200] [--size 480x640]
 
 Rooms of the synthetic test split (never trained on), each once closed, as `render` gives it, and once with a window
 onto a street (`MixedSyntheticDataset("test", far_view_prob=1)`, lipjax.data.synthetic.far_view: a rectangle of a
@@ -13,21 +13,17 @@ the given size (`lipjax.inference.complete_frame`), the table gives per frame th
 fill on the unsampled valid pixels, and the geometric mean and wins over the frames.
 
 A closed room never shows the prox a far sample among near ones: the 228,000-image lip-any, 0.781x linear on the 12
-closed rooms (wins 11), is 1.014x with their windows (wins 5) (docs/design-notes.md, "Far views inside rooms").
+closed rooms (wins 11), is 1.014x with their windows (wins 5) (research/README.md).
 """
 from __future__ import annotations
 
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.generalisation import ratio_to_linear  # noqa: E402
-from lipjax.data.synthetic.dataset import MixedSyntheticDataset  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import ratio_to_linear
+from lipjax.data.synthetic.dataset import MixedSyntheticDataset
+from lipjax.methods import get_completer
 
 
 def run(model: str | None, frames: int, points: int, size: tuple[int, int]) -> dict[str, list[float]]:

@@ -6,8 +6,8 @@ linear fill (lipjax.crosscheck) would mix that fill into what is measured here, 
 
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
-    python benchmarks/failure_look.py [--model NAME] [--synthetic 8] [--realdata ../shared/realdata] [--plot PNG]
-                                      [--json OUT]
+    python -m research.failure_look [--model NAME] [--synthetic 8] [--realdata ../shared/realdata] [--plot PNG]
+                                    [--json OUT]
 
 Every frame is completed at its native size through the default path (`get_completer(None, sparse)`,
 `complete_frame`; `--model` puts one model, a name or a path, through the same path), once with its photograph
@@ -16,12 +16,13 @@ points indoors, the HDL-64 pattern on KITTI; the synthetic test renders get the 
 points, streets 352x1216 with HDL-64). Each unsampled valid pixel falls in one
 class, from the ground truth and the photograph at native size:
 
-    depth edge    within NEAR_PX of a pixel where |d log D| > DEPTH_EDGE along x or y (central differences
+    depth edge    within CLASS_NEAR_PX of a pixel where |d log D| > DEPTH_EDGE along x or y (central differences
                   where both ends are valid: KITTI's semi-dense ground truth has few pixels with all four)
-    colour only   within NEAR_PX of a pixel with |grad I| > COLOUR_EDGE, and no depth edge near
+    colour only   within CLASS_NEAR_PX of a pixel with |grad I| > COLOUR_EDGE, and no depth edge near
     flat          the rest
 
-(I: the grey image in [0, 1] after a Gaussian blur; gradient and thresholds from benchmarks/edge_statistics.py.)
+(I: the grey image in [0, 1] after a Gaussian blur; the classes, gradients and thresholds: research.common,
+shared with research/edge_statistics.py.)
 Per class it prints the change of the squared-error sum against linear as a share of linear's total,
 
     model - linear     sum_class(e_model^2 - e_linear^2) / sum_all(e_linear^2)
@@ -35,33 +36,15 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import sys
 
-import cv2
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from benchmarks.edge_statistics import COLOUR_EDGE, DEPTH_EDGE, gradients, log_depth_step  # noqa: E402
-from benchmarks.real_frames import GREY, frames_and_inputs  # noqa: E402
-from lipjax.data.sampling import LidarSampler, UniformSampler  # noqa: E402
-from lipjax.data.synthetic import SyntheticDataset  # noqa: E402
-from lipjax.inference import complete_frame  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
-
-NEAR_PX = 3  # pixels at native size
-CLASSES = ("depth edge", "colour only", "flat")
-
-
-def _near(mask: np.ndarray) -> np.ndarray:
-    return cv2.dilate(mask.astype(np.uint8), np.ones((2 * NEAR_PX + 1,) * 2, np.uint8)).astype(bool)
-
-
-def pixel_classes(rgb: np.ndarray, depth: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """Per pixel 0 (depth edge), 1 (colour only) or 2 (flat), as the module docstring defines them."""
-    ok = valid & (depth > 0)
-    colour_gradient = gradients(rgb, np.where(ok, depth, 0))[0]
-    depth_near, colour_near = _near(log_depth_step(depth, valid) > DEPTH_EDGE), _near(colour_gradient > COLOUR_EDGE)
-    return np.where(depth_near, 0, np.where(colour_near, 1, 2))
+from benchmarks.common import GREY, REALDATA, frames_and_inputs
+from lipjax.data.sampling import LidarSampler, UniformSampler
+from lipjax.data.synthetic import SyntheticDataset
+from lipjax.inference import complete_frame
+from lipjax.methods import get_completer
+from research.common import CLASSES, pixel_classes
 
 
 def frame_row(name: str, input_name: str, rgb, depth, valid, sparse, linear,
@@ -133,7 +116,7 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default=None, help="a model name or path (default: the default path's choice)")
     ap.add_argument("--synthetic", type=int, default=8, help="synthetic test frames per kind")
-    ap.add_argument("--realdata", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "realdata"))
+    ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--plot", default=None, help="write the worst frames' error maps here (PNG)")
     ap.add_argument("--worst", type=int, default=4, help="frames in the picture")
     ap.add_argument("--json", default=None)

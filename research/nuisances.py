@@ -3,11 +3,11 @@
 The model's own estimate is scored (`cross_check=False`): the default path's check against the linear fill
 (lipjax.crosscheck) would mix that fill into what is measured here.
 
-    python benchmarks/nuisances.py [--model PATH] [--frames 8]
+    python -m research.nuisances [--model PATH] [--frames 8]
 
 On the shared real frames the default model given a grey image does as well as with the photograph, while on the
-renders the image is worth 16-54 % (docs/design-notes.md, "RGB guidance from renders to photographs"). This puts one
-nuisance at a time on test-split renders (never trained on), each frame at full size through the default path
+renders the image is worth 16-54 % (research/README.md, edge_statistics). This puts one nuisance at a time on
+test-split renders (never trained on), each frame at full size through the default path
 (`lipjax.inference.complete_frame`), and gives the RMSE ratio to the Delaunay linear fill with the image and with a
 uniform grey one; their quotient is the image's worth (grey / image: above 1, the image helps). A nuisance that
 takes the worth to about 1 on the renders is a candidate cause; one that leaves it is not.
@@ -34,22 +34,17 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
-import sys
 import zlib
 
 import cv2
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-from benchmarks.failure_look import pixel_classes  # noqa: E402
-from benchmarks.generalisation import frames, geometric_mean, ratios_to_linear  # noqa: E402
-from benchmarks.real_frames import GREY  # noqa: E402
-from lipjax.data.augment import Augment, camera_noise, paint_texture, relight  # noqa: E402
-from lipjax.data.synthetic import render_with_info  # noqa: E402
-from lipjax.data.synthetic.renderer import Reflection  # noqa: E402
-from lipjax.methods import get_completer  # noqa: E402
+from benchmarks.common import GREY, frames, geometric_mean, ratios_to_linear
+from lipjax.data.augment import Augment, camera_noise, paint_texture, relight
+from lipjax.data.synthetic import render_with_info
+from lipjax.data.synthetic.renderer import Reflection
+from lipjax.methods import get_completer
+from research.common import pixel_classes
 
 SCENES = (("rooms 200 points", "indoor", (480, 640), "uniform:200"),
           ("streets HDL-64", "outdoor", (352, 1216), "lidar:hdl64"))
