@@ -3,12 +3,13 @@
     model = jaxpr_to_onnx.convert(fn, [jax.ShapeDtypeStruct((1, 64, 80, 3), jnp.uint8), ...], ["rgb", ...], ["depth"])
     onnx.save(model, "m.onnx")
 
-Why a translator of our own and not jax2onnx: jax2onnx (0.17) pins orbax-checkpoint < 0.11.37, below the
-orbax-checkpoint this package trains with, so it cannot be a dependency of lipjax; this module needs only the
-`onnx` package. It translates the primitives lipjax's inference graphs use (the LIP models, the initial fills,
-the resizes; PRIMITIVES lists them) and names any other one in a one-line NotImplementedError. Since the graph is
-the jaxpr of the function JAX runs, the exported model computes what the JAX model computes, to float32 rounding
-(tests/test_onnx_export.py checks each primitive and whole models under onnxruntime).
+Why a translator of our own and not jax2onnx (ARCHITECTURE.md, "ONNX"): jax2onnx 0.17.1 installs beside lipjax only
+with orbax-checkpoint held below 0.11.37 and some 25 packages lipjax does not use, and it exports the default graph
+only after two library functions are rewritten around its gaps; this module needs only the `onnx` package. It
+translates the primitives lipjax's inference graphs use (the LIP models, the initial fills, the resizes; PRIMITIVES
+lists them) and names any other one in a one-line NotImplementedError. Since the graph is the jaxpr of the function
+JAX runs, the exported model computes what the JAX model computes, to float32 rounding (tests/test_onnx_export.py
+checks each primitive and whole models under onnxruntime).
 
 How:
   - Every value is either a numpy array known at conversion time (the function's closed-over constants, such as
