@@ -102,22 +102,30 @@ def _mean_std(values: list[float], digits: int = 4) -> str:
 
 
 def markdown(doc: dict, images: int) -> str:
-    lines = [f"# The equal-budget study ({images:,} training images per run)", ""]
+    left = doc["details"]["scores_left"]
+    lines = [f"# The equal-budget study ({images:,} training images per run)", "",
+             f"Written by `python -m experiments.equal_budget --report`; {len(left)} score(s) of the study still to "
+             "run (`python -m experiments.equal_budget --plan` lists them).", ""]
     for scene in SCENES:
         summary = doc.get(scene)
         if not summary:
             continue
         linear = summary.get("linear", {}).get("rmse_m")
+        curves = doc["details"][scene]["curve_rmse_m"]
         lines += [f"## {'Table I, rooms, 200 points' if scene == 'indoor' else 'Table II, streets, 64 beams'}", "",
-                  "| method | images | seeds | RMSE m | MAE m | RMSE / linear |", "|---|---:|---|---:|---:|---:|"]
+                  "| method | images | seeds | RMSE m | MAE m | RMSE / linear | RMSE m by training images, mean over "
+                  "seeds |",
+                  "|---|---:|---|---:|---:|---:|---|"]
         for method, row in summary.items():
             if "seeds" in row:
                 ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
+                curve_text = ", ".join(f"{int(n):,}: {statistics.mean(v):.3f}"
+                                       for n, v in sorted(curves.get(method, {}).items(), key=lambda kv: int(kv[0])))
                 lines.append(f"| {method} | {row['images']:,} | {','.join(map(str, row['seeds']))} | "
-                             f"{_mean_std(row['rmse_m'])} | {_mean_std(row['mae_m'])} | {ratio} |")
+                             f"{_mean_std(row['rmse_m'])} | {_mean_std(row['mae_m'])} | {ratio} | {curve_text} |")
             else:
                 lines.append(f"| {method} (no training) | | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
-                             f"{row['rmse_m'] / linear:.2f}x |")
+                             f"{row['rmse_m'] / linear:.2f}x | |")
         tests = doc["details"][scene]["paired_tests"]
         if tests:
             lines += ["", "| paired test | seeds | frames | mean RMSE a / b m | a better on | Wilcoxon p | t-test p |",
@@ -184,9 +192,11 @@ def plot_iterations(path: pathlib.Path, per_k: dict, title: str) -> None:
 
 def write_report(study, out: pathlib.Path | None = None) -> dict:
     """Writes the report of `study` (an experiments.equal_budget.Study) into `out` (default: <root>/report)."""
+    from experiments.equal_budget import missing
+
     out = pathlib.Path(out) if out is not None else study.root / "report"
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict = {"details": {}}
+    doc: dict = {"details": {"scores_left": missing(study)}}
     for scene in SCENES:
         scores = load_scores(study.root, scene)
         classical_path = study.root / scene / "results" / "classical.json"
