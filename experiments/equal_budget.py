@@ -7,7 +7,7 @@ the tables' synthetic test splits (issue 52).
     python -m experiments.equal_budget --plan          # what is done and what is left, without running anything
     python -m experiments.equal_budget --report        # docs/results/equal_budget.json, tables, figures, tests
     python -m experiments.equal_budget --tiny --root /tmp/study --images 96 --curve 48,96 --tune-images 32 \\
-        --adv-images 32 --limit 2                        # a check in a minute: tiny networks on 48x64 frames
+        --adv-images 40 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames
 
 Methods (experiments/configs/study.py): Ma et al. (ma2018), U-Net, CSPN, LIP+CNN with the paper's prox (lip-cnn),
 LIP with the fast prox (lip-fast), and LIP+AD of each (lip-ad, lip-ad-fast: the last adv_images of the budget
