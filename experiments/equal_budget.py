@@ -259,6 +259,13 @@ def missing(study: Study) -> list[str]:
     return left
 
 
+def _done(study: Study, scene: str, trunk: str, seed: int, upto: int) -> bool:
+    """Whether every score of the trunk and its branches up to `upto` images exists."""
+    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    return all(result_path(study, scene, m, seed, b).exists() for m in methods
+               for b in study.budgets_for(scene, seed) if b <= upto)
+
+
 def run_study(study: Study, progress: bool = True) -> None:
     for scene, trunk, seed, upto in plan(study):
         score_classical(study, scene)
@@ -313,7 +320,8 @@ def main(argv=None) -> None:
 
     if args.plan:
         left = missing(study)
-        print("\n".join(f"{s} {t} seed {k} up to {n} images" for s, t, k, n in plan(study)))
+        print("\n".join(f"{s} {t} seed {k} up to {n} images" + (" (done)" if _done(study, s, t, k, n) else "")
+                        for s, t, k, n in plan(study)))
         print(f"{len(left)} scores left" + "".join(f"\n  {line}" for line in left))
         return
     enable_compilation_cache()
