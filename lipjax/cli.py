@@ -4,7 +4,7 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)] [--threads N]
                     [--uncertainty FILE] [--max-uncertainty M] [--fill-all | --blank-unsupported]
-                    [--[no-]mirror] [--no-cross-check]
+                    [--[no-]mirror] [--no-cross-check] [--explain: print each frame's plan, write nothing]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
@@ -35,12 +35,16 @@ def _cmd_complete(args) -> int:
     from lipjax import files, utils
     if args.threads:
         utils.limit_cpu_threads(args.threads)
+    frames = {k: getattr(args, k) for k in ("lidar", "calib", "camera", "depth_scale", "model", "iterations",
+                                            "max_side", "cross_check", "mirror")}  # what the plan of a frame needs
+    if args.explain:
+        print(files.explain_files(args.rgb, args.depth, **frames).summary())
+        return 0
     done = files.complete_files(
         args.rgb, args.depth, args.out, intrinsics=args.intrinsics or args.intrinsics_file, progress=not args.quiet,
         log=None if args.quiet else console.say, workers=min(args.threads or files.READ_WORKERS, files.READ_WORKERS),
-        **{k: getattr(args, k) for k in ("lidar", "calib", "camera", "depth_scale", "model", "iterations", "max_side",
-                                         "out_format", "color_range", "ply", "cross_check", "uncertainty",
-                                         "max_uncertainty", "fill_all", "blank_unsupported", "mirror")})
+        **frames, **{k: getattr(args, k) for k in ("out_format", "color_range", "ply", "uncertainty",
+                                                   "max_uncertainty", "fill_all", "blank_unsupported")})
     if not args.quiet:
         console.say(done.summary())
     return 0
@@ -138,24 +142,23 @@ def _add_complete_parser(sub) -> None:
     c.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG value per metre: 256 (kitti), "
                    "1000 (nyu), 5000 (tum); required by .png input (no default); .png output: 256 when not given")
     _add_model_args(c, f"shipped model (lipjax models), saved model path or classical fill ({', '.join(CLASSICAL)})")
-    c.add_argument("--out", required=True, help="X.npy | X.png | X.color.png, or a folder with folder inputs")
+    out = c.add_mutually_exclusive_group(required=True)  # where to write, or --explain: the plan alone
+    out.add_argument("--out", help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, help="per-frame format with folder inputs")
-    c.add_argument("--max-side", type=console.positive_int, metavar="N",
-                   help="run frames downsized to this longer side (default: the working size of the samples)")
+    c.add_argument("--max-side", type=console.positive_int, metavar="N", help="run downsized to this longer side")
     c.add_argument("--color-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"),
                    help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
     c.add_argument("--ply", help="also write a coloured point cloud (.ply; a folder with folder inputs)")
     _add_intrinsics_args(c, "pixels, of the RGB image", '"fx fy cx cy", the 9 numbers of K, or a calibration file')
-    c.add_argument("--uncertainty", metavar="FILE",
-                   help="also write the expected absolute error: .npy metres or .png picture (a folder with folders)")
+    c.add_argument("--uncertainty", metavar="FILE", help="also write the expected absolute error (above)")
     c.add_argument("--max-uncertainty", type=float, metavar="M", help="depth 0 where the expected error > M metres")
     where = c.add_mutually_exclusive_group()  # neither: what the model or method returns, as lipjax.complete
     where.add_argument("--fill-all", action="store_true", help="depth at every pixel (0s a method leaves: nearest)")
     where.add_argument("--blank-unsupported", action="store_true", help="0 where no sample supports the depth")
     c.add_argument("--mirror", action=_BOOL, help="learned models: average in the mirror image (default: scan lines)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
-    c.add_argument("--threads", type=console.positive_int, metavar="N",
-                   help="run on N CPU cores (pins XLA's, OpenCV's and the readers' threads; default: every core)")
+    out.add_argument("--explain", action="store_true", help="print each frame's plan; run and write nothing (above)")
+    c.add_argument("--threads", type=console.positive_int, metavar="N", help="run on N CPU cores (default: every one)")
     c.add_argument("-q", "--quiet", action="store_true", help="no progress bar, model choice or summary")
     c.set_defaults(func=_cmd_complete)
 
@@ -177,9 +180,8 @@ def _add_project_parser(sub) -> None:
 def _add_evaluate_parser(sub) -> None:
     e = sub.add_parser("evaluate", help="metrics of model(s) on the synthetic test split, your folder or a training "
                        "data source (Markdown table)")
-    e.add_argument("--model", "--method", dest="model", action="append",
-                   help=f"shipped model, saved model path, or a classical fill ({', '.join(CLASSICAL)}); repeat "
-                        "to compare (default: the default model of the input)")
+    e.add_argument("--model", "--method", dest="model", action="append", help=f"shipped model, saved model path, or "
+                   f"a classical fill ({', '.join(CLASSICAL)}); repeat to compare (default: the default model)")
     e.add_argument("--iterations", type=console.positive_int, metavar="K")
     data = e.add_mutually_exclusive_group()
     data.add_argument("--data", help="synthetic-indoor (default) | synthetic-outdoor | FOLDER with rgb/ depth/ "
@@ -248,14 +250,12 @@ def _add_data_parser(sub) -> None:
 
 def _add_train_parser(sub) -> None:
     t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames")
-    t.add_argument("--data", required=True,
-                   help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated LiDAR only], or train/ "
-                        "and val/ holding them")
+    t.add_argument("--data", required=True, help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated "
+                   "LiDAR only], or train/ and val/ holding them")
     t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
                    "complete --model OUT)")
     t.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre")
-    t.add_argument("--init", help="model to start from: shipped name or saved path (default: the "
-                   "default model of the frames' scene, as lipjax complete picks it)")
+    t.add_argument("--init", help="model to start from: shipped name or saved path (default: the default model)")
     t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {TRAINING.steps})")
     t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {TRAINING.batch_size})")
     t.add_argument("--sampler", help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "

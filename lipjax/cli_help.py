@@ -92,6 +92,10 @@ leaves free); `--mirror` does so on every input, `--no-mirror` on none.
 With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
 every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
 `--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
+`--explain` prints each frame's plan and stops: no model runs and nothing is written (no --out needed). A line per
+decision: the model; the samples' pattern (scan lines; scattered; few points, under 100; dense, a depth camera's
+map with holes), their number and spacing; the working size; the initial fill; flip averaging; residual
+spreading; the check against the linear fill; whether the measured pixels are set back.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, an output
 folder that cannot be written, ...) print one line "lipjax: error: ..." and exit with status 1; set LIPJAX_DEBUG=1

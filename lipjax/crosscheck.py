@@ -44,13 +44,10 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from lipjax.classical.interpolate import linear_fill, linear_fill_at
+from lipjax.defaults import FOLDS, MIN_SAMPLES, P_VALUE, SEED  # why each, and its benchmark: lipjax.defaults
 from lipjax.inputs import is_lidar_pattern, quietly
 from lipjax.resolution import dense_from, working_size
 
-FOLDS = 5  # the samples are held out in this many disjoint folds, each completed from the others
-MIN_SAMPLES = 100  # fewer samples: no check (too few held out to test, and every sample is needed)
-P_VALUE = 0.05  # the sign test's level: the model gives way only on this much evidence
-SEED = 0  # which samples fall in which fold: fixed, so that a frame always gives the same depth
 # Threads that run held-out estimates beside the frame's own (module doc): the first fold, then the others at once.
 _FOLDS_BESIDE = ThreadPoolExecutor(max_workers=FOLDS - 1, thread_name_prefix="lipjax-crosscheck")
 

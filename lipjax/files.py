@@ -3,6 +3,7 @@
     done = complete_files("frame.png", "sparse.npy", "dense.npy", model="linear")          # one frame
     done = complete_files("rgb/", "sparse/", "dense/", depth_scale=1000, out_format="png")   # a folder of frames
     print(done.summary())     # "wrote 100 frame(s) to dense in 12.3 s: 8.13 frames/s"
+    print(explain_files("frame.png", "sparse.npy").summary())   # each frame's plan (--explain): nothing run or written
     print(project_file("image.png", "sweep.bin", "calib.txt", "sparse.npy").summary())      # a LiDAR sweep
 
 Depth is in metres; 0 means no depth. The parameters of `complete_files` are the flags of `lipjax complete` (its
@@ -44,15 +45,15 @@ from typing import Any
 
 import numpy as np
 
-from lipjax import inference
+from lipjax import defaults
 from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, output_format, pair_frames, read_frame,
                                 read_intrinsics, read_rgb, write_depth)
 from lipjax.data.lidar import project_sweep, read_lidar_frame
 from lipjax.data.sample import Intrinsics
 from lipjax.classical import fill_holes
-from lipjax.inference import CROSS_CHECK, Completer, complete_frame, frame_size
-from lipjax.inputs import (SCENE_MEDIAN_M, check_depth_scale, is_lidar_pattern, likely_units, scene_reason,
-                           unit_hint)
+from lipjax.defaults import CROSS_CHECK
+from lipjax.inference import Completer, FramePlan, complete_frame, frame_size, one_frame, plan_frame
+from lipjax.inputs import SCENE_MEDIAN_M, check_depth_scale, is_lidar_pattern, likely_units, unit_hint
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.methods import get_completer
 from lipjax.pointcloud import IntrinsicsLike, ProjectionCounts, backproject_rgbd, write_ply
@@ -102,13 +103,9 @@ def plan_jobs(rgb: str | os.PathLike, depth: str | os.PathLike, out: str | os.Pa
 
     Raises ValueError (a one-line message naming the `lipjax complete` flag) for missing inputs, a file given
     with a folder, a folder mixing .png and .npy depth, or an unknown output format."""
+    pairs = frame_pairs(rgb, depth)
     rgb, depth, out = Path(rgb), Path(depth), Path(out)
     ply, uncertainty = ply and Path(ply), uncertainty and Path(uncertainty)
-    for p in (rgb, depth):
-        if not p.exists():
-            raise ValueError(f"{p}: no such file or folder")
-    if rgb.is_dir() != depth.is_dir():
-        raise ValueError("--rgb and --depth must both be files or both be folders")
     if not rgb.is_dir():
         if out_format:
             raise ValueError("--out-format is for folders; for one frame the extension of --out chooses the format")
@@ -116,8 +113,6 @@ def plan_jobs(rgb: str | os.PathLike, depth: str | os.PathLike, out: str | os.Pa
         if uncertainty and uncertainty.suffix.lower() not in (".npy", ".png"):
             raise ValueError(f"--uncertainty {uncertainty}: use .npy (metres) or .png (colour picture)")
         return Plan([Job(rgb, depth, out, ply or None, uncertainty or None)], fmt, depth.suffix.lower() != ".png")
-    pairs = [(r, d) for _, r, d in pair_frames(rgb, depth)]
-    check_one_depth_format([d for _, d in pairs])
     for flag, path in (("--out", out), ("--ply", ply), ("--uncertainty", uncertainty)):
         if path and path.exists() and not path.is_dir():
             raise ValueError(f"{flag} {path}: with input folders, {flag} must be a folder")
@@ -126,6 +121,22 @@ def plan_jobs(rgb: str | os.PathLike, depth: str | os.PathLike, out: str | os.Pa
     jobs = [Job(r, d, out / f"{r.stem}.{fmt}", ply / f"{r.stem}.ply" if ply else None,
                 uncertainty / f"{r.stem}.npy" if uncertainty else None) for r, d in pairs]
     return Plan(jobs, fmt, depth_suffix == ".npy")
+
+
+def frame_pairs(rgb: str | os.PathLike, depth: str | os.PathLike) -> list[tuple[Path, Path]]:
+    """(rgb, depth) paths of one frame, or of the frames of two folders (paired by `pair_frames`, one depth format);
+    ValueError, one line, for missing inputs or a file given with a folder."""
+    rgb, depth = Path(rgb), Path(depth)
+    for p in (rgb, depth):
+        if not p.exists():
+            raise ValueError(f"{p}: no such file or folder")
+    if rgb.is_dir() != depth.is_dir():
+        raise ValueError("--rgb and --depth must both be files or both be folders")
+    if not rgb.is_dir():
+        return [(rgb, depth)]
+    pairs = [(r, d) for _, r, d in pair_frames(rgb, depth)]
+    check_one_depth_format([d for _, d in pairs])
+    return pairs
 
 
 @dataclasses.dataclass(frozen=True)
@@ -163,8 +174,9 @@ class Completed:
             wrote = f"{len(self.outputs)} frame(s) to {self.out} in {self.seconds:.1f} s"
             notes.append(f"{len(self.outputs) / self.seconds:.3g} frames/s")
         if self.holes:
-            notes.append(f"{100 * self.holes:.1f} % of the pixels given the nearest depth (--fill-all)" if self.filled
-                         else f"{100 * self.holes:.1f} % of the pixels left at 0 by {self.method}"
+            share = f"{100 * self.holes:.1f}" if self.holes >= 0.001 else f"{100 * self.holes:.1g}"  # not "0.0 %"
+            notes.append(f"{share} % of the pixels given the nearest depth (--fill-all)" if self.filled
+                         else f"{share} % of the pixels left at 0 by {self.method}"
                          + ("" if self.unsupported else " (--fill-all fills them)"))
         if self.unsupported:
             notes.append(f"{100 * self.unsupported:.1f} % of the pixels without support set to 0 "
@@ -291,14 +303,13 @@ class _Writer:
 
 def _load(model: Any, iterations: int | None, sparse: np.ndarray, rgb_file: Path, max_side: int | None,
           log: Callable[[str], None] | None):
-    """The completer of `model` (the default of the first frame's scene when None), named with its reason to
-    `log`; warns when the frame is large enough to want --max-side."""
-    completer = get_completer(model, iterations, sparse=sparse)
+    """The completer of `model` (the default when None: one for every input, named to `log`); warns when the frame
+    is large enough to want --max-side."""
+    completer = get_completer(model, iterations)
     if model is None and log is not None:
-        scene, why = scene_reason(sparse)
-        log(f"model: {completer.name}, the default for {scene} input ({why}); choose another with --model")
+        log(f"model: {completer.name}, the default for every input; choose another with --model")
     h, w = frame_size(completer, sparse, max_side)
-    if max_side is None and h * w > inference.LARGE_FRAME_PIXELS:  # read here: tests lower it
+    if max_side is None and h * w > defaults.LARGE_FRAME_PIXELS:  # read here: tests lower it
         warnings.warn(f"{rgb_file}: a {sparse.shape[0]}x{sparse.shape[1]} frame ({sparse.size / 1e6:.1f} Mpixel) "
                       "runs slowly and needs gigabytes at full size; --max-side 1024 runs it downsized", stacklevel=2)
     return completer
@@ -372,7 +383,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
             bar.close()
 
 
-def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike, *,
+def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike | None, *,
                    lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
                    depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
                    max_side: int | None = None, mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
@@ -410,15 +421,12 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
     cannot be written, contradicting flags, ...).
     """
     start = time.perf_counter()
+    if out is None:
+        raise ValueError("--out is required: the file (or folder) to write; only --explain writes nothing")
     if fill_all and blank_unsupported:
         raise ValueError("--fill-all (depth at every pixel) and --blank-unsupported (0 where no sample supports it) "
                          "contradict each other; pass one of them")
-    if (depth is None) == (lidar is None):
-        raise ValueError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
-    if (lidar is None) != (calib is None):
-        raise ValueError("--lidar SWEEP and --calib FILE go together: the sweep, and its calibration with the camera")
-    if lidar is not None and Path(rgb).is_dir():
-        raise ValueError("--lidar takes one sweep with one --rgb image, not a folder")
+    check_sources(rgb, depth, lidar, calib)
     if max_uncertainty is not None and not max_uncertainty >= 0:
         raise ValueError(f"--max-uncertainty {max_uncertainty:g}: must be >= 0 metres")
     intrinsics = read_intrinsics(intrinsics, camera)
@@ -437,9 +445,7 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
                       "metres, never scaled (--depth-scale applies to .png depth, in and out)", stacklevel=2)
 
     def read(job: Job) -> tuple[Job, np.ndarray, np.ndarray, Intrinsics | None]:
-        if lidar is None:
-            return (job, *read_depth_frame(job.rgb, job.depth, depth_scale), intrinsics)
-        frame_rgb, sparse, calibrated = read_lidar_frame(job.rgb, job.depth, calib, camera)
+        frame_rgb, sparse, calibrated = read_inputs(job.rgb, job.depth, depth_scale, calib, camera)
         return job, frame_rgb, sparse, intrinsics or calibrated
 
     output = _Output(plan.fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, tuple(color_range) if color_range else None,
@@ -449,6 +455,59 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
     return Completed([j.out for j in plan.jobs], [j.ply for j in plan.jobs if j.ply], Path(out),
                      time.perf_counter() - start, output.unsupported / pixels,
                      output.color_range if output.fitted else None, output.holes / pixels, fill_all, output.method)
+
+
+def check_sources(rgb: str | os.PathLike, depth: str | os.PathLike | None, lidar: str | os.PathLike | None,
+                  calib: str | os.PathLike | None) -> None:
+    """ValueError, one line, unless the sparse input comes one way: `depth` (a file, or a folder with an `rgb`
+    folder), or one `lidar` sweep with its `calib` for one `rgb` image."""
+    if (depth is None) == (lidar is None):
+        raise ValueError("give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE")
+    if (lidar is None) != (calib is None):
+        raise ValueError("--lidar SWEEP and --calib FILE go together: the sweep, and its calibration with the camera")
+    if lidar is not None and Path(rgb).is_dir():
+        raise ValueError("--lidar takes one sweep with one --rgb image, not a folder")
+
+
+def read_inputs(rgb: Path, depth: Path, depth_scale: float | None = None, calib: str | os.PathLike | None = None,
+                camera: int = 2) -> tuple[np.ndarray, np.ndarray, Intrinsics | None]:
+    """(rgb (H, W, 3) uint8, sparse (H, W) float32 metres, the intrinsics a calibration gives or None) of one frame
+    as `lipjax complete` reads it: an image and its sparse depth (`read_depth_frame`), or with `calib` an image and
+    the LiDAR sweep `depth` projected into it (lipjax.data.lidar.read_lidar_frame; KITTI `camera`)."""
+    if calib is None:
+        return (*read_depth_frame(rgb, depth, depth_scale), None)
+    return read_lidar_frame(rgb, depth, calib, camera)
+
+
+@dataclasses.dataclass(frozen=True)
+class Explained:
+    """What `explain_files` found: each frame's RGB file with its plan (lipjax.inference.FramePlan)."""
+
+    frames: list[tuple[Path, FramePlan]]
+
+    def summary(self) -> str:
+        """What `lipjax complete --explain` prints: each frame's RGB file, then its plan, one decision a line."""
+        return "\n".join(f"{path}:\n" + "\n".join(f"  {line}" for line in plan.describe())
+                         for path, plan in self.frames)
+
+
+def explain_files(rgb: str | os.PathLike, depth: str | os.PathLike | None = None, *,
+                  lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
+                  depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
+                  max_side: int | None = None, mirror: bool | None = None,
+                  cross_check: bool = CROSS_CHECK) -> Explained:
+    """The plan (lipjax.inference.plan_frame) of every frame that `complete_files` completes with the same
+    arguments: each frame read and checked and its plan made; no model runs and nothing is written (`lipjax
+    complete --explain`). Raises ValueError / OSError, one line, as `complete_files` does."""
+    check_sources(rgb, depth, lidar, calib)
+    completer, frames = None, []
+    for rgb_path, depth_path in frame_pairs(rgb, depth if lidar is None else lidar):
+        frame_rgb, sparse, _ = read_inputs(rgb_path, depth_path, depth_scale, calib, camera)
+        _, sparse = one_frame(frame_rgb, sparse)
+        if completer is None:  # after the first frame is read, as `complete_files` loads it
+            completer = get_completer(model, iterations)
+        frames.append((rgb_path, plan_frame(completer, sparse, max_side, mirror=mirror, cross_check=cross_check)))
+    return Explained(frames)
 
 
 def check_npy_depth_dtype(path: str | os.PathLike) -> None:

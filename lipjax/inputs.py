@@ -34,6 +34,7 @@ from collections.abc import Callable, Iterator
 import numpy as np
 
 from lipjax.data.folder import KNOWN_DEPTH_SCALES
+from lipjax.defaults import SCAN_LINE_COLUMN_RATIO, SCAN_LINE_ROW_GAP_PX, SCAN_LINE_ROW_SHARE
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.resolution import dense_from
 from lipjax.shipped import DEFAULT_MODELS, available
@@ -69,14 +70,15 @@ class InputError(ValueError):
 
 
 def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "this model",
-                 scan_lines_trained: bool = False, both_scenes: bool = False) -> tuple[np.ndarray, np.ndarray, bool]:
+                 scan_lines_trained: bool = False, both_scenes: bool = False, *,
+                 scan_lines: bool | None = None) -> tuple[np.ndarray, np.ndarray, bool]:
     """Validates and batches inputs. Returns (rgb (B,H,W,3) uint8|float32, sparse (B,H,W) float32, was_batched).
 
     Raises InputError for: a wrong rank or channel count, an rgb dtype other than uint8 / float in [0, 1],
     mismatching sizes, non-float sparse depth (a raw PNG), NaN / inf or negative depth, an image without any
     sample, and depth that is clearly not metres. With `max_depth_m`, the range (metres) of the model `name`,
     also `check_for_model` (scan_lines_trained: the model's training input included LiDAR scan lines;
-    both_scenes: it was trained on rooms and streets).
+    both_scenes: it was trained on rooms and streets; scan_lines: the samples' pattern, where the caller knows it).
     """
     rgb = np.asarray(rgb)
     sparse = np.asarray(sparse)
@@ -107,7 +109,7 @@ def check_inputs(rgb, sparse, max_depth_m: float | None = None, name: str = "thi
     if median > MAX_PLAUSIBLE_DEPTH_M:
         raise InputError(f"sparse depth has a median of {median:.0f}: not metres ({unit_hint_of(sparse)})")
     if max_depth_m is not None:
-        check_for_model(sparse, max_depth_m, name, scan_lines_trained, both_scenes)
+        check_for_model(sparse, max_depth_m, name, scan_lines_trained, both_scenes, scan_lines)
     if np.issubdtype(rgb.dtype, np.floating):
         rgb = rgb.astype(np.float32)
     return rgb, sparse.astype(np.float32), batched
@@ -126,20 +128,22 @@ def check_frame(rgb, sparse) -> tuple[np.ndarray, np.ndarray]:
 
 def is_lidar_pattern(sparse: np.ndarray) -> bool:
     """Whether the samples of a (H, W) map lie in LiDAR scan lines: most samples have a neighbour in their row
-    at most 4 px away, and samples in a column are at least twice as far apart as in a row. (Runs on every frame,
-    several times: flatnonzero and the early returns keep it ~1 ms on a KITTI scan and ~0.1 ms on 200 points.)"""
+    (SCAN_LINE_ROW_SHARE) at most 4 px away (SCAN_LINE_ROW_GAP_PX, the median), and samples in a column are at least
+    twice as far apart as in a row (SCAN_LINE_COLUMN_RATIO; lipjax.defaults). The default path asks it once per frame
+    (lipjax.inference.plan_frame); flatnonzero and the early returns keep it ~1 ms on a KITTI scan and ~0.1 ms on 200
+    points."""
     sparse = np.asarray(sparse)
     rows, cols = np.divmod(np.flatnonzero(sparse > 0), sparse.shape[-1])  # row-major, as np.nonzero
     in_row = (cols[1:] - cols[:-1])[rows[1:] == rows[:-1]]  # consecutive samples of one row
-    if rows.size == 0 or in_row.size < rows.size / 2:
+    if rows.size == 0 or in_row.size < rows.size * SCAN_LINE_ROW_SHARE:
         return False
     row_gap = float(np.median(in_row))
-    if row_gap > 4:
+    if row_gap > SCAN_LINE_ROW_GAP_PX:
         return False
     order = np.lexsort((rows, cols))
     rows, cols = rows[order], cols[order]
     in_col = (rows[1:] - rows[:-1])[cols[1:] == cols[:-1]]
-    return in_col.size == 0 or float(np.median(in_col)) >= 2 * row_gap
+    return in_col.size == 0 or float(np.median(in_col)) >= SCAN_LINE_COLUMN_RATIO * row_gap
 
 
 def suggest_scene(sparse: np.ndarray) -> str:
@@ -225,13 +229,15 @@ def _other_model(name: str, scene: str) -> str:
 
 
 def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this model",
-                    scan_lines_trained: bool = False, both_scenes: bool = False) -> None:
+                    scan_lines_trained: bool = False, both_scenes: bool = False,
+                    scan_lines: bool | None = None) -> None:
     """Compares checked (B, H, W) or (H, W) sparse depth (metres) with what a model of range `max_depth_m` was
     trained on: raises InputError where a unit mistake is near certain, warns (one line) where it is probable or
     the input is unlike the training data. See the module docstring for the rules. scan_lines_trained: the
     model's training input included LiDAR scan lines (lipjax.inference.Completer.scan_lines_trained), so scan
     lines are no warning for it. both_scenes: the model was trained on rooms and streets (with scan lines), so only
-    the unit checks and the density warning apply."""
+    the unit checks and the density warning apply. scan_lines: whether the samples lie in LiDAR scan lines, where
+    the caller knows it (the default path's plan of the full-size frame); None: `is_lidar_pattern` is asked."""
     sparse = np.asarray(sparse)
     samples = sparse[sparse > 0]
     median = float(np.median(samples))
@@ -239,8 +245,9 @@ def check_for_model(sparse: np.ndarray, max_depth_m: float, name: str = "this mo
         raise InputError(f"sparse depth has a median of {median:.0f} m, over 10x the {max_depth_m:g} m range of "
                          f"{name}: not metres ({unit_hint_of(sparse)})")
     indoor = max_depth_m <= INDOOR_DEPTH_M
-    lidar = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
-    density = samples.size / sparse.size
+    if scan_lines is None:
+        scan_lines = any(is_lidar_pattern(s) for s in sparse.reshape((-1,) + sparse.shape[-2:]))
+    lidar, density = scan_lines, samples.size / sparse.size
     if both_scenes:
         if median > max_depth_m or samples.max() > 4 * max_depth_m:
             _warn(f"sparse depth far beyond the {max_depth_m:g} m range of {name}: centimetres given as metres? "

@@ -102,9 +102,15 @@ class LearnedModel(abc.ABC):
         """Names of the keyword inputs `host_inputs` returns (an exported model takes them as extra inputs)."""
         return ()
 
-    def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
-        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse metres; none by default."""
+    def host_inputs(self, sparse: np.ndarray, scan_lines: bool | None = None) -> dict[str, np.ndarray]:
+        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse metres; none by default.
+        `scan_lines`: whether the samples lie in LiDAR scan lines, where the caller knows it (None: not known)."""
         return {}
+
+    def initial_fill(self, scan_lines: bool) -> str | None:
+        """The initial estimate the model starts from on samples in LiDAR scan lines or not (`scan_lines`), by
+        name; None (the default): none, the model takes the sparse map itself (an end-to-end network)."""
+        return None
 
     def with_iterations(self, params: Params, num_iterations: int) -> tuple["LearnedModel", Params]:
         """(config, params) of the same model run for `num_iterations` iterations; iterative models only."""

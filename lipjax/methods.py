@@ -7,7 +7,7 @@ lipjax.classical), and nothing it builds imports it.
     get_completer("linear")            a hand-crafted fill (CLASSICAL): nearest, linear, ip_basic,
     get_completer("ip_basic", extrapolate=True)   ip_basic_multiscale, ip_basic_adaptive, colorization; keyword
                                        arguments override the method's settings
-    get_completer(None, sparse=s)      the shipped default model of the scene the samples suggest
+    get_completer(None)                the shipped default model, one for every input (lipjax.defaults)
     get_completer(obj)                 a completer object, returned as is
     listing()                          what `lipjax models` prints: the shipped models, then the hand-crafted ones
 
@@ -37,8 +37,8 @@ from lipjax.classical import (
 )
 from lipjax.interfaces import DepthCompleter
 from lipjax.classical.lip_wavelet import LIPWavelet
-from lipjax.inference import CROSS_CHECK, Completer, complete_frame, default_model, load_model
-from lipjax.inputs import suggest_scene
+from lipjax.defaults import CROSS_CHECK
+from lipjax.inference import Completer, complete_frame, default_model, load_model
 from lipjax.interfaces import MIXED_SCENES
 from lipjax.shipped import available
 from lipjax.uncertainty import drop_uncertain, expected_error, mask_unsupported
@@ -71,16 +71,17 @@ def get_completer(model: Any = None, iterations: int | None = None, sparse: np.n
 
     Args:
       model: a completer object; a name (CLASSICAL, a shipped model) or a saved model path; or None for
-        `lipjax.inference.default_model`, outdoor when `sparse` looks outdoor (`lipjax.inputs.suggest_scene`).
+        `lipjax.inference.default_model`, the one default for every input.
       iterations: run a LIP model's first K iterations only.
-      sparse: (H, W) or (B, H, W) metres, only to choose the default model's scene.
+      sparse: unused; from when the default model followed the scene the samples suggested (both scenes' default is
+        one model now, lipjax.shipped.DEFAULT_MODELS).
       settings: keyword settings of a hand-crafted method; learned models keep theirs in their model file.
     """
     if settings and not (isinstance(model, str) and model in CLASSICAL):
         raise ValueError(f"settings apply to hand-crafted methods; {model!r} is a learned model (its settings are in "
                          "its model file) or a completer object")
     if model is None:
-        completer = default_model("indoor" if sparse is None else suggest_scene(sparse))
+        completer = default_model()
     elif isinstance(model, (str, os.PathLike)):
         name = os.fspath(model)
         completer = CLASSICAL[name](**settings) if name in CLASSICAL else load_model(name)
@@ -105,11 +106,11 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, fill_all
              mirror: bool | None = None, cross_check: bool = CROSS_CHECK):
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
-    `model`: anything `get_completer` takes; by default the shipped default model, indoor or outdoor as the samples
-    suggest. A learned model runs at the working size of the samples' spacing (`lipjax.inference.complete_frame`),
-    every measured pixel set back; a hand-crafted method (CLASSICAL) returns exactly what it returns itself, as
-    published (IP-Basic leaves 0 out of reach of its dilations). `mirror` also runs a learned model on the
-    mirror-image frame and averages (more accurate, twice the model's work; None: on LiDAR scan lines,
+    `model`: anything `get_completer` takes; by default the shipped default model. Each frame runs through the
+    default path (`lipjax.inference.complete_frame`, as its `plan_frame` says): a learned model at the working size
+    of the samples' spacing, every measured pixel set back; a hand-crafted method (CLASSICAL) returns exactly what
+    it returns itself, as published (IP-Basic leaves 0 out of reach of its dilations). `mirror` also runs a learned
+    model on the mirror-image frame and averages (more accurate, twice the model's work; None: on LiDAR scan lines,
     lipjax.inference.mirrors); `cross_check` checks it against the linear fill on held-out samples
     (lipjax.crosscheck; CROSS_CHECK).
     By default the depth is the model's or method's, at every pixel it gives depth, as `lipjax complete` writes it.
@@ -122,7 +123,7 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, fill_all
     if fill_all and blank_unsupported:
         raise ValueError("fill_all (depth at every pixel) and blank_unsupported (0 where no sample supports it) "
                          "contradict each other; pass one of them")
-    completer = get_completer(model, sparse=sparse)
+    completer = get_completer(model)
     rgb, sparse = np.asarray(rgb), np.asarray(sparse)
     if sparse.ndim == 3:
         dense = np.stack([complete_frame(completer, c, y, mirror=mirror, cross_check=cross_check)

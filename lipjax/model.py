@@ -97,11 +97,21 @@ class LIPConfig(LearnedModel):
     def host_input_names(self) -> tuple[str, ...]:
         return ("z0",) if self.needs_host_initial_estimate else ()
 
-    def host_inputs(self, sparse: np.ndarray) -> dict[str, np.ndarray]:
-        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse depth: {"z0": ...} or {}."""
+    def host_inputs(self, sparse: np.ndarray, scan_lines: bool | None = None) -> dict[str, np.ndarray]:
+        """Extra keyword inputs of `apply` computed on the host from (B, H, W) sparse depth: {"z0": ...} or {}.
+        `scan_lines`: the samples' pattern where the caller knows it (the default path's plan, asked of the full-size
+        frame), for the "auto" fill; None: "auto" asks lipjax.inputs.is_lidar_pattern of each map."""
         if not self.needs_host_initial_estimate:
             return {}
-        return {"z0": host_initial_estimate(self.initial_estimate, sparse)}
+        kind = self.initial_estimate if scan_lines is None else self.initial_fill(scan_lines)
+        return {"z0": host_initial_estimate(kind, sparse)}
+
+    def initial_fill(self, scan_lines: bool) -> str:
+        """z_0's kind on samples in LiDAR scan lines or not: `initial_estimate`, with "auto" resolved (nearest on
+        scan lines, linear otherwise)."""
+        if self.initial_estimate != "auto":
+            return self.initial_estimate
+        return "nearest" if scan_lines else "linear"
 
     def with_iterations(self, params, num_iterations: int) -> tuple["LIPConfig", Any]:
         """(config, params) for the first K = num_iterations iterations: the first K per-iteration proxes and rho_k
@@ -244,7 +254,7 @@ def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
     from lipjax.classical.interpolate import linear_fill  # scipy-based; imported lazily (host only)
     from lipjax.classical.nearest import nearest_fill
 
-    def auto_fill(s):
+    def auto_fill(s):  # LIPConfig.initial_fill, its pattern asked of each map
         return nearest_fill(s) if is_lidar_pattern(s) else linear_fill(s)
 
     fill = {"linear": linear_fill, "nearest": nearest_fill, "auto": auto_fill}[kind]

@@ -63,8 +63,9 @@ import jax
 import jax.numpy as jnp
 
 from lipjax import jaxpr_to_onnx
+from lipjax.defaults import SPREAD_RESIDUALS
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import SPREAD_RESIDUALS, Completer, mirrors
+from lipjax.inference import Completer, mirrors
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import dense_from, is_capped, working_size
@@ -118,7 +119,7 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
     graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
     average with the mirror-image frame as lipjax.complete does (None: on scan lines, lipjax.inference.mirrors);
-    `spread`: spread the samples' residuals after the resize back, as it does (lipjax.inference.SPREAD_RESIDUALS),
+    `spread`: spread the samples' residuals after the resize back, as it does (lipjax.defaults.SPREAD_RESIDUALS),
     with the sigmas of LiDAR scan lines or (`scan_lines=False`) of scattered samples
     (lipjax.spread.spread_sigmas_px)."""
     config = completer.config

@@ -43,13 +43,9 @@ import math
 
 import numpy as np
 
-TARGET_SPACING_PX = 16.0  # mean sample spacing, pixels, at which the learned prox runs (see the module doc)
-# Samples per pixel above which a map is a depth camera's or stereo's, not LiDAR's (KITTI's raw scans: ~5 %): dense.
-DENSE = 0.3
-MAX_WORKING_PIXELS = 60_000  # the largest working size of LiDAR scan lines, pixels (see the module doc)
-MIN_WORKING_SIDE_PX = 64  # the prox downsamples 8x internally; below this its coarsest features are 8 px wide
-MIN_MAX_SIDE_PX = 16  # the smallest longer side a user may ask for (--max-side): two of the prox's 8 px cells
-MIN_SCALE_CHANGE = 0.9  # scales above this run at full size: a resize would cost more than it brings
+# the rule's numbers (why each, and its benchmark: lipjax.defaults); DENSE and MIN_MAX_SIDE_PX also read from here
+from lipjax.defaults import (DENSE, MAX_WORKING_PIXELS, MIN_MAX_SIDE_PX, MIN_SCALE_CHANGE,  # noqa: F401
+                             MIN_WORKING_SIDE_PX, TARGET_SPACING_PX)
 
 
 def sample_spacing_px(sparse_m: np.ndarray) -> float:

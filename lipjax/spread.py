@@ -24,14 +24,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-# the Gaussian's sigma for scattered samples, in working pixels (docs/decisions/0018-residual-spreading.md)
-SIGMA_WORKING_PX = 0.5
-# LiDAR scan lines (sigma across the lines = along the rows' axis, sigma along them), in working pixels
-# (docs/decisions/0019-scan-line-sigmas.md): their samples lie a pixel or two apart along a line and several working
-# pixels apart across the lines
-SCAN_LINE_SIGMAS_WORKING_PX = (1.0, 0.25)
-DELTA = 0.05  # the fade: delta = DELTA x the Gaussian's centre weight (docs/decisions/0018)
-RADIUS_SIGMAS = 3.0  # the Gaussian's taps reach ceil(RADIUS_SIGMAS sigma) pixels either side
+# why each, and its benchmark: lipjax.defaults (SCAN_LINE_SIGMAS_WORKING_PX: across the lines = along the rows' axis,
+# then along them)
+from lipjax.defaults import DELTA, RADIUS_SIGMAS, SCAN_LINE_SIGMAS_WORKING_PX, SIGMA_WORKING_PX
 
 
 def spread_sigmas_px(frame: tuple[int, int], working: tuple[int, int], scan_lines: bool = False

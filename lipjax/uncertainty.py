@@ -40,18 +40,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from lipjax.defaults import ABOVE_GAIN, ABOVE_SPACINGS, REACH_SPACINGS, SPREAD_GAIN  # why, benchmark: there
 from lipjax.utils import written_whole
-
-SPREAD_GAIN = 0.1217
-"""Expected |error| per metre of nearby sample depth spread and per spacing of distance (dimensionless)."""
-ABOVE_GAIN = 0.1613
-"""Expected |error| per metre of depth above the highest samples (dimensionless)."""
-ABOVE_SPACINGS = 1.0
-"""A pixel more than this many sample spacings above the highest sample of its column has no support."""
-REACH_SPACINGS = 3.0
-"""A pixel farther than this many sample spacings from every sample has no support: on the real frames (NYU, 200
-points: s = 35 px; KITTI, HDL-64 pattern: s = 6.4 px) no NYU pixel below the top sample is that far, and about 1 %
-of a KITTI frame's pixels are (holes in the scan), of which about 1 in 100 has ground truth."""
 
 
 def box_sample_spacing_px(sparse: np.ndarray) -> float:

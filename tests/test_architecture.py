@@ -33,7 +33,7 @@ LAYERS = {
     "lipjax.operators": 0, "lipjax.admm": 0, "lipjax.fill": 0, "lipjax.priors": 0, "lipjax.interfaces": 0,
     "lipjax.metrics": 0, "lipjax.zbuffer": 0, "lipjax.viz": 0, "lipjax.shipped": 0, "lipjax.utils": 0,
     "lipjax.resolution": 0, "lipjax.resample": 0, "lipjax.spread": 0, "lipjax.jaxpr_to_onnx": 0,
-    "lipjax.console": 0,
+    "lipjax.console": 0, "lipjax.defaults": 0,
     # 1: frames: data sets, samplers, the synthetic renderer, input checks, hand-crafted completers
     "lipjax.data": 1, "lipjax.pointcloud": 1, "lipjax.inputs": 1, "lipjax.classical": 1,
     # 2: learned models and their files
@@ -222,6 +222,22 @@ def test_private_names_stay_inside_their_package():
                 if private and node.module.rsplit(".", 1)[0] != package:
                     found.append(f"{path.relative_to(ROOT)}: from {node.module} import {', '.join(private)}")
     assert found == []
+
+
+def test_the_default_paths_numbers_are_assigned_in_lipjax_defaults_only():
+    """Issue 53: every number and switch of the default path is in one place, lipjax/defaults.py, with its reason and
+    the command that re-derives it; a module that uses one imports it from there rather than assigning its own."""
+    def assigned(path: Path) -> set[str]:
+        targets = [t for node in ast.parse(path.read_text(), str(path)).body
+                   for t in (node.targets if isinstance(node, ast.Assign) else
+                             [node.target] if isinstance(node, ast.AnnAssign) else [])]
+        return {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+
+    numbers = assigned(PACKAGE / "defaults.py")
+    found = [f"{path.relative_to(ROOT)}: {name}" for path in sorted(PACKAGE.rglob("*.py"))
+             if path != PACKAGE / "defaults.py" for name in sorted(assigned(path) & numbers)]
+    assert {"TARGET_SPACING_PX", "CROSS_CHECK", "MIRROR_SCAN_LINES", "SPREAD_RESIDUALS", "FOLDS"} <= numbers
+    assert found == [], "\n".join(found)
 
 
 def test_every_import_goes_down_the_layers():

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import lipjax
+import lipjax.defaults
 import lipjax.methods
 from lipjax import cli, model_io, viz
 from lipjax.model import LIPConfig
@@ -240,15 +241,13 @@ def test_lidar_sweep_in_completes_its_projection_and_its_calibration_serves_the_
 
 def test_the_default_model_is_named_with_its_reason_and_depth_scale_on_npy_warns(model, frame, tmp_path, capsys,
                                                                                 monkeypatch):
-    """Without --model, one line names the model chosen and why (none with -q); --depth-scale with .npy depth and
-    .npy output warns that it is ignored."""
-    monkeypatch.setattr(lipjax.methods, "default_model", lambda scene: model[1])
+    """Without --model, one line names the model chosen, the one default for every input (none with -q);
+    --depth-scale with .npy depth and .npy output warns that it is ignored."""
+    monkeypatch.setattr(lipjax.methods, "default_model", lambda: model[1])
     args = ["complete", "--rgb", frame["rgb"], "--depth", frame["npy"], "--out", str(tmp_path / "out.npy")]
     assert cli.main(args) == 0
-    median = np.median(frame["sparse_array"][frame["sparse_array"] > 0])
     assert capsys.readouterr().err.splitlines()[0] == (
-        f"model: {model[0]}, the default for indoor input (scattered samples, median depth {median:.1f} m); "
-        "choose another with --model")
+        f"model: {model[0]}, the default for every input; choose another with --model")
     assert cli.main(args + ["-q"]) == 0 and capsys.readouterr().err == ""
     assert cli.main(args + ["-q", "--depth-scale", "256"]) == 0
     assert capsys.readouterr().err == ("lipjax: warning: --depth-scale 256 is ignored: .npy depth is metres, never "
@@ -281,7 +280,10 @@ def test_color_picture_range_fits_depth_beyond_the_models(model, tmp_path, capsy
 def test_usage_error_returns_2_with_one_line(capsys):
     assert cli.main(["complete", "--rgb", "a.png"]) == 2
     err = capsys.readouterr().err
-    assert _one_error_line(err).startswith("lipjax complete: error: the following arguments are required")
+    assert _one_error_line(err).startswith("lipjax complete: error: one of the arguments --out --explain is required")
+    assert cli.main(["complete", "--depth", "a.npy", "--out", "b.npy"]) == 2
+    err = capsys.readouterr().err
+    assert _one_error_line(err).startswith("lipjax complete: error: the following arguments are required: --rgb")
 
 
 def _one_error_line(err, prog="lipjax"):
@@ -321,7 +323,7 @@ def test_mixed_png_npy_folder_fails_before_writing_and_names_the_odd_file(model,
 
 
 def test_large_frame_prints_a_max_side_hint(model, frame, tmp_path, capsys, monkeypatch):
-    monkeypatch.setattr(lipjax.inference, "LARGE_FRAME_PIXELS", H * W - 1)
+    monkeypatch.setattr(lipjax.defaults, "LARGE_FRAME_PIXELS", H * W - 1)
     assert _complete(model, frame, tmp_path / "out.npy") == 0
     assert "--max-side" in _one_error_line(capsys.readouterr().err, "lipjax: warning:")
     assert _complete(model, frame, tmp_path / "out.npy", "--max-side", "16") == 0
@@ -485,6 +487,38 @@ def scan_frame(tmp_path_factory):
     sparse = LidarSampler.hdl64(azimuth_step_deg=0.5)(street)
     rgb_path, npy = _write_frame(tmp_path_factory.mktemp("scan"), street.rgb, sparse, depth_name="sparse.npy")
     return {"rgb": rgb_path, "npy": npy, "rgb_array": street.rgb, "sparse_array": sparse}
+
+
+def test_explain_prints_each_frames_plan_and_writes_nothing(model, tmp_path, capsys):
+    """--explain: the plan of each frame (lipjax.inference.plan_frame), one decision a line under the frame's file:
+    200 points on a room are scattered and cross-checked, a street seen by a 64-beam LiDAR is scan lines and
+    flip-averaged; no model runs, nothing is written, no --out taken (-q prints it all the same). The library says
+    so too (files.explain_files, and complete_files without an output)."""
+    from lipjax.data.sampling import LidarSampler, UniformSampler
+    from lipjax.data.synthetic.dataset import render
+    from lipjax import files
+    from lipjax.inference import plan_frame
+
+    room, street = render("indoor", "test", 0, height=120, width=160), render("outdoor", "test", 0, 128, 416)
+    inputs = (("room", room, UniformSampler(200)), ("street", street, LidarSampler.hdl64()))
+    frames = [_write_frame(tmp_path / name, f.rgb, sampler(f), depth_name="sparse.npy") for name, f, sampler in inputs]
+    shown = {}
+    for (rgb, npy), pattern, on, off in zip(frames, ("scattered", "scan lines"), ("cross-check", "flip averaging"),
+                                            ("flip averaging", "cross-check")):
+        assert cli.main(["complete", "--rgb", rgb, "--depth", npy, "--model", model[0], "--explain", "-q"]) == 0
+        printed = capsys.readouterr().out.splitlines()
+        assert printed[0] == f"{rgb}:" and printed[2].startswith(f"  pattern: {pattern} (")
+        assert [line for line in printed if line.startswith(f"  {on}")][0].endswith(": on")
+        assert ": off" in [line for line in printed if line.startswith(f"  {off}")][0]
+        assert printed[1:] == [f"  {line}" for line in plan_frame(model[1], np.load(npy)).describe()]
+        shown[pattern] = printed
+    assert [len(list((tmp_path / name).iterdir())) for name in ("room", "street")] == [2, 2]  # rgb.png, sparse.npy
+    rgb_path, npy = frames[0]
+    assert cli.main(["complete", "--rgb", rgb_path, "--depth", npy, "--explain", "--out", "o.npy"]) == 2
+    assert "not allowed with" in _one_error_line(capsys.readouterr().err)
+    assert files.explain_files(rgb_path, npy, model=model[0]).summary().splitlines() == shown["scattered"]
+    with pytest.raises(ValueError, match="--out is required"):
+        files.complete_files(rgb_path, npy, None, model=model[0])
 
 
 @pytest.mark.parametrize("flag, setting", [(None, {}), ("--fill-all", {"fill_all": True}),

@@ -193,7 +193,8 @@ def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
     sparse = _scattered(depth, 100)
     sizes = []
     call = Completer.__call__
-    monkeypatch.setattr(Completer, "__call__", lambda self, rgb, s: sizes.append(rgb.shape[:2]) or call(self, rgb, s))
+    monkeypatch.setattr(Completer, "__call__",
+                        lambda self, rgb, s, **kw: sizes.append(rgb.shape[:2]) or call(self, rgb, s, **kw))
     model = Completer.random(LIPConfig(initial_estimate="nearest"))
     x = complete_at(model, np.full(depth.shape + (3,), 128, np.uint8), sparse, depth.shape)
     assert sorted(sizes, reverse=True) == [(160, 200)] + [(128, 160)] * crosscheck.FOLDS  # in threads: any order

@@ -158,14 +158,14 @@ def test_after_the_first_frame_two_are_completed_at_once_and_a_failing_one_stops
     data = _frames(tmp_path / "in", ["0", "1", "2", "3", "4", "5"])
     third_begun, call = threading.Event(), Completer.__call__
 
-    def overlapping(self, rgb, sparse):
+    def overlapping(self, rgb, sparse, **kw):  # kw: the frame's pattern (lipjax.inference.model_run)
         if sparse[0, 0] == 2:
             assert third_begun.wait(10), "frame 1 ran alone"
         if sparse[0, 0] == 3:
             third_begun.set()
         if sparse[0, 0] == 5:
             raise RuntimeError("frame 4 fails")
-        return call(self, rgb, sparse)
+        return call(self, rgb, sparse, **kw)
 
     monkeypatch.setattr(files, "model_threads", lambda completer: 2)  # on a 1-core machine too
     monkeypatch.setattr(Completer, "__call__", overlapping)

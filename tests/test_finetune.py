@@ -143,3 +143,20 @@ def test_fine_tuning_a_folder_of_mixed_sizes_on_its_own_input_gives_a_model_that
     assert "WORSE than 0.0000 at step 0 (the last, as asked" in capsys.readouterr().out.splitlines()[-1]
     with pytest.raises(ValueError, match="keep='newest': choose 'best'"):
         fine_tune_folder(root, tmp_path / "x" / "mine", keep="newest", **common)
+
+
+def test_a_model_of_both_scenes_fine_tuned_on_a_folder_still_serves_both():
+    """lip-any fine-tuned on one folder keeps metadata "data": "mixed" (no warning that its input looks like the
+    other scene's); a per-scene model fine-tuned on a folder records the folder."""
+    from lipjax.interfaces import MIXED_SCENES
+    from lipjax.train.config import TrainConfig, DataConfig
+    from lipjax.train.run import trained_on
+
+    folder = DataConfig(source="folder", root="my_frames")
+    lip_any = lipjax.load_model("lip-any")
+    assert lip_any.both_scenes
+    assert trained_on(TrainConfig(name="mine", model=lip_any.config, data=folder, init_from="lip-any")) == MIXED_SCENES
+    indoor = lipjax.load_model("lip-fast-indoor")
+    fine_tuned = TrainConfig(name="mine", model=indoor.config, data=folder, init_from="lip-fast-indoor")
+    assert trained_on(fine_tuned) == "folder"
+    assert trained_on(TrainConfig(name="x", model=indoor.config, data=DataConfig(kind="outdoor"))) == "outdoor"

@@ -291,3 +291,70 @@ def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estim
     got = complete_at(completer, rgb, lines, (20, 28), mirror=False)  # one run: the spread alone
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-5)
     assert np.abs(spread_on_host(z, lines, (20, 28)) - expected)[lines == 0].max() > 1e-3
+
+
+@pytest.fixture(scope="module")
+def street_and_room():
+    """(rgb, sparse m) of a synthetic 352x1216 street seen by a 64-beam LiDAR, and of a 480x640 room with 200 uniform
+    points: the two inputs the default path was tuned for."""
+    from lipjax.data.sampling import LidarSampler, UniformSampler
+    from lipjax.data.synthetic.dataset import render
+
+    street, room = render("outdoor", "test", 0, height=352, width=1216), render("indoor", "test", 0, 480, 640)
+    return (street.rgb, LidarSampler.hdl64()(street)), (room.rgb, UniformSampler(200)(room))
+
+
+def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
+    """plan_frame decides what the default path does to a frame before anything runs: a 64-beam scan is scan lines,
+    flip-averaged, not cross-checked, at the capped working size, from the nearest fill; 200 points on a room are
+    scattered, cross-checked, not flip-averaged, from the linear fill; its lines say so (lipjax complete --explain)."""
+    model = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), initial_estimate="auto"))
+    (_, scan), (_, points) = street_and_room
+    plan = inference.plan_frame(model, scan)
+    assert (plan.pattern, plan.scan_lines, plan.mirror, plan.cross_check, plan.fill) == (
+        "scan lines", True, True, False, "nearest")
+    assert plan.size == (132, 455) and plan.spread and plan.set_back and plan.samples == np.count_nonzero(scan)
+    lines = plan.describe()
+    assert lines[1].startswith("pattern: scan lines (a spinning LiDAR's): ") and "flip averaging: on" in lines
+    assert "cross-check against the linear fill: off (not on scan lines)" in lines
+    assert lines[2] == ("working size: 132x455 (0.38x of 352x1216; the rule: samples about 16 px apart, at most "
+                        "60,000 pixels for scan lines)")
+    plan = inference.plan_frame(model, points)
+    assert (plan.pattern, plan.scan_lines, plan.mirror, plan.cross_check, plan.fill, plan.size) == (
+        "scattered", False, False, True, "linear", (196, 261))
+    lines = plan.describe()
+    assert lines[1] == "pattern: scattered (100 or more, not in scan lines): 200 samples on 480x640, 39.2 px apart"
+    assert "cross-check against the linear fill: on" in lines and "flip averaging: off" in lines
+    # the switches and the caller's size; a hand-crafted method: at full size, as it returns, never checked
+    plan = inference.plan_frame(model, points, 160, mirror=True, cross_check=False)
+    assert (plan.size, plan.mirror, plan.cross_check) == ((120, 160), True, False)
+    assert "cross-check against the linear fill: off (turned off)" in plan.describe()
+    plan = inference.plan_frame(methods.get_completer("linear"), scan)
+    assert (plan.learned, plan.size, plan.fill, plan.mirror, plan.cross_check, plan.set_back) == (
+        False, (352, 1216), None, False, False, False)
+    with pytest.raises(lipjax.InputError, match="mirror averaging is for learned models"):
+        inference.plan_frame(methods.get_completer("linear"), scan, mirror=True)
+
+
+@pytest.mark.filterwarnings("ignore:sparse depth beyond", "ignore:samples in LiDAR")  # an indoor model on a street
+def test_the_default_path_asks_the_samples_pattern_once_per_frame(street_and_room, monkeypatch):
+    """Issue 53: the pattern is asked of the full-size frame once (plan_frame) and passed down: the model's input
+    checks and its "auto" fill on the working-size map, the mirror image and the held-out folds take it."""
+    import cv2
+
+    from lipjax import crosscheck, inputs, model as model_module
+
+    asked, ask = [], inputs.is_lidar_pattern
+    for module in (inputs, inference, model_module, crosscheck):
+        monkeypatch.setattr(module, "is_lidar_pattern", lambda s: asked.append(np.shape(s)) or ask(s))
+    model = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), initial_estimate="auto"))
+    for rgb, sparse in street_and_room:  # a quarter of the size, for speed
+        asked.clear()
+        small = tuple(s // 4 for s in sparse.shape)
+        frame_rgb, frame_sparse = cv2.resize(rgb, small[::-1]), inference.reproject_sparse(sparse, small)
+        inference.complete_frame(model, frame_rgb, frame_sparse)
+        assert asked == [small]
+    # told the pattern, the model's own "auto" fill gives what it finds by itself
+    rgb, scan = (a[-64:, :256] for a in street_and_room[0])
+    assert inputs.is_lidar_pattern(scan)
+    np.testing.assert_array_equal(model(rgb, scan, scan_lines=True), model(rgb, scan))

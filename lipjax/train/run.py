@@ -23,6 +23,7 @@ import jax
 import numpy as np
 
 from lipjax import model_io
+from lipjax.interfaces import MIXED_SCENES
 from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
@@ -169,7 +170,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         d = config.data
         what = f"mean of steps {averaged['checkpoints']}" if averaged else f"step {int(state.step)}"
         meta = {"val_metrics": val, "val_sampler": d.val_sampler, "val_images": d.val_images,
-                "data": d.kind if d.source == "synthetic" else d.source, **averaged}
+                "data": trained_on(config), **averaged}
         if worse and keep == "best":
             return kept_start(config, state, export, meta, start, what)
         export_model(config, state, export, meta)
@@ -180,6 +181,17 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         print(f"[lipjax] {config.name} at step {int(state.step)} in {workdir}: val rmse_m={val['rmse_m']:.4f}{before} "
               "(nothing exported; add --export PATH)")
     return val
+
+
+def trained_on(config: TrainConfig) -> str:
+    """A model's metadata "data": the synthetic scenes' kind, else the source; MIXED_SCENES for a model fine-tuned
+    from one of both scenes (lip-any on your folder keeps serving rooms and streets without a warning that its
+    input looks like the other scene's, lipjax.inference.Completer.both_scenes)."""
+    d = config.data
+    name = d.kind if d.source == "synthetic" else d.source
+    if config.init_from and model_io.metadata(config.init_from).get("data") == MIXED_SCENES:
+        return MIXED_SCENES
+    return name
 
 
 def kept_start(config: TrainConfig, state: Any, export: str | os.PathLike, meta: dict, start: dict,
