@@ -16,7 +16,10 @@ with the study's seed, batch 8, a constant learning rate after 100 warm-up steps
 images (batch x steps, a branch's D steps included), equal for every method.
 
 Stages, each skipped when its output exists, so the study continues across sessions and survives any stop (every
-run is a checkpointed training that resumes):
+run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
+(experiments/study_scores, committed: a new machine goes on from them); runs, checkpoints and models stay in --root
+(runs/study, not committed) except the run in progress at a session's end, whose workdir may be committed under
+experiments/warm_starts/study/<scene>/<trunk>/seed<k> to be continued from:
   1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS
      (seed 0, the validation split: never the test split); the same small budget for every trunk;
   2. per scene, per seed: each trunk to each budget of its curve (--curve points <= --images for every seed, all of
@@ -31,6 +34,7 @@ import argparse
 import dataclasses
 import json
 import pathlib
+import shutil
 import sys
 
 import numpy as np
@@ -50,6 +54,9 @@ TEST_LIMIT = {"indoor": 100, "outdoor": 50}  # the tables' default frame counts
 DEFAULT_SEEDS = {"indoor": (0, 1, 2), "outdoor": (0,)}
 DEFAULT_CURVE = {"indoor": (10_000, 30_000, 100_000), "outdoor": ()}
 BATCH = 8
+SCORES = "experiments/study_scores"  # the study's record: tuning and per-frame scores (JSON), kept in the repository
+# A run's workdir committed to continue from (at most one a session: the run in progress when the session ended)
+WARM_STARTS = pathlib.Path("experiments/warm_starts/study")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -59,6 +66,7 @@ class Study:
     tables' own counts); tiny: tiny networks and frames (checks, not results)."""
 
     root: pathlib.Path
+    scores: pathlib.Path = pathlib.Path(SCORES)
     scenes: tuple[str, ...] = SCENES
     seeds: dict = dataclasses.field(default_factory=lambda: dict(DEFAULT_SEEDS))
     images: int = 30_000
@@ -84,17 +92,22 @@ class Study:
         return sorted({self.images, *(c for c in curve if c <= self.images or seed == 0)})
 
     def scene_dir(self, scene: str) -> pathlib.Path:
+        """The runs, checkpoints and models of a scene (not committed)."""
         return self.root / scene
+
+    def scores_dir(self, scene: str) -> pathlib.Path:
+        """The tuning and the scores of a scene: small JSON files, committed, so that a new machine goes on."""
+        return self.scores / scene
 
 
 # ---- stage 1: tuning -------------------------------------------------------------------------------------------
 
 def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) -> float:
     """The trunk's learning rate: the lowest validation RMSE after tune_images images of seed 0 among TUNE_LRS
-    (cached in <scene>/tuning.json with every rate's score)."""
+    (cached in <scores>/<scene>/tuning.json with every rate's score)."""
     from lipjax.train.loop import evaluate_params, train, validation_batches
 
-    path = study.scene_dir(scene) / "tuning.json"
+    path = study.scores_dir(scene) / "tuning.json"
     table = json.loads(path.read_text()) if path.exists() else {}
     scores = table.get(trunk, {})
     for lr in TUNE_LRS:
@@ -119,7 +132,7 @@ def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
 # ---- stage 2: runs and scores ----------------------------------------------------------------------------------
 
 def result_path(study: Study, scene: str, method: str, seed: int, images: int) -> pathlib.Path:
-    return study.scene_dir(scene) / "results" / f"{method}-seed{seed}-{images}.json"
+    return study.scores_dir(scene) / f"{method}-seed{seed}-{images}.json"
 
 
 def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:
@@ -135,6 +148,10 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
     config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
                                        tiny=study.tiny), study.workers)
     workdir = study.scene_dir(scene) / trunk / f"seed{seed}"
+    committed = WARM_STARTS / scene / trunk / f"seed{seed}"
+    if not workdir.exists() and committed.is_dir() and not study.tiny:  # a new machine: go on from the committed one
+        shutil.copytree(committed, workdir)
+        print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
     for images in stops:
         if not _needed(study, scene, trunk, seed, images, budgets, wanted_branches):
             continue
@@ -181,7 +198,7 @@ def run_branch(study: Study, scene: str, method: str, trunk: TrainConfig, seed: 
 
 def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path) -> dict:
     """Scores `model` on the scene's test split (Table I / II input, protocol and frames), per frame, and for a LIP
-    model at every iteration count K (Fig. 4a); writes results/<method>-seed<seed>-<images>.json."""
+    model at every iteration count K (Fig. 4a); writes <scores>/<scene>/<method>-seed<seed>-<images>.json."""
     from lipjax.evaluate import evaluate
     from lipjax.inference import load_model
     from lipjax.model import LIPConfig
@@ -217,11 +234,11 @@ def test_setup(study: Study, scene: str):
 
 
 def score_classical(study: Study, scene: str) -> dict:
-    """The linear and nearest fills on the same test frames (<scene>/results/classical.json)."""
+    """The linear and nearest fills on the same test frames (<scores>/<scene>/classical.json)."""
     from lipjax.evaluate import evaluate
     from lipjax.methods import get_completer
 
-    path = study.scene_dir(scene) / "results" / "classical.json"
+    path = study.scores_dir(scene) / "classical.json"
     if path.exists():
         return json.loads(path.read_text())
     dataset, sampler, protocol, limit = test_setup(study, scene)
@@ -296,7 +313,8 @@ def main(argv=None) -> None:
     p.add_argument("--adv-images", type=int, default=2_000)
     p.add_argument("--methods", help=f"comma-separated, of {','.join(METHODS)} (default: all)")
     p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
-    p.add_argument("--root", default="runs/study", help="runs, models and scores (default runs/study)")
+    p.add_argument("--root", default="runs/study", help="runs, checkpoints and models (default runs/study)")
+    p.add_argument("--scores", default=SCORES, help=f"tuning and scores, committed (default {SCORES})")
     p.add_argument("--results", default="docs/results", help="where --report writes (default docs/results)")
     p.add_argument("--workers", type=int, default=1, help="loader processes per run (default 1; 14 on a 16-core "
                    "GPU host)")
@@ -311,7 +329,8 @@ def main(argv=None) -> None:
     if unknown:
         p.error(f"unknown method(s) {unknown}; choose of {','.join(METHODS)}")
     try:
-        study = Study(pathlib.Path(args.root), scenes, {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
+        study = Study(pathlib.Path(args.root), pathlib.Path(args.scores), scenes,
+                      {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
                       args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
                       args.tune_images, args.adv_images, args.limit, args.tiny, methods, args.workers)
     except ValueError as exc:

@@ -6,14 +6,14 @@
 #       bash experiments/gpu_run.sh
 #
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops) in
-# runs/study, which it continues where a carried runs/study/<scene>/tuning.json and results/ (device `carry`) say it
-# stands, then packs what it finished into OUT: log.txt, scores.tgz (tuning, scores, the report) and the exported
-# models at the budget IMAGES, models.tgz.* (15 MB parts). Back on the CPU machine:
+# runs/study, going on from the committed tuning and scores (experiments/study_scores, in the working tree that
+# travels), then packs what it finished into OUT: log.txt, scores.tgz (the tuning and scores, and the report) and the
+# exported models at the budget IMAGES, models.tgz.* (15 MB parts). Back on the CPU machine:
 #
-#   tar xzf scores.tgz -C runs/study && cat models.tgz.* | tar xzf - -C runs/study
+#   tar xzf scores.tgz && cat models.tgz.* | tar xzf - -C runs/study      # then commit experiments/study_scores
 #
 # and the CPU study (python -m experiments.equal_budget) skips what the GPU finished. TINY=1: the tiny check
-# (tiny networks, 48x64 frames, a few images) in its own root, runs/study-tiny, to test the script on a CPU.
+# (tiny networks, 48x64 frames, a few images) in its own root and scores, runs/study-tiny, to test it on a CPU.
 set -u
 T0=$(date +%s)
 : "${OUT:?OUT=output folder}"
@@ -22,9 +22,11 @@ RESERVE_S=${RESERVE_S:-60}
 WORKERS=${WORKERS:-14}
 IMAGES=${IMAGES:-30000}
 ROOT=runs/study
+SCORES=experiments/study_scores
 ARGS="${STUDY_ARGS:-}"
 if [ -n "${TINY:-}" ]; then
   ROOT=runs/study-tiny
+  SCORES=$ROOT/scores
   IMAGES=96
   ARGS="--tiny --curve 48,96 --tune-images 32 --adv-images 40 --limit 2 --methods ma2018,lip-cnn,lip-ad $ARGS"
 fi
@@ -40,12 +42,12 @@ python3 -c "import jax, flax, grain; print('jax', jax.__version__, 'flax', flax.
   >> "$LOG" 2>&1 || { echo "import failed" >> "$LOG"; exit 4; }
 LEFT=$(( BUDGET_S - ($(date +%s) - T0) - RESERVE_S ))
 echo "== the study for $LEFT s: $ARGS" >> "$LOG"
-timeout -s TERM "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --results "$ROOT/report" --workers \
-  "$WORKERS" --images "$IMAGES" --no-progress $ARGS >> "$LOG" 2>&1
+timeout -s TERM "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" \
+  --results "$ROOT/report" --workers "$WORKERS" --images "$IMAGES" --no-progress $ARGS >> "$LOG" 2>&1
 echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
-python3 -m experiments.equal_budget --root "$ROOT" --results "$ROOT/report" --report --images "$IMAGES" $ARGS >> "$LOG" 2>&1
-(cd "$ROOT" && tar czf "$OUT/scores.tgz" --exclude='*/checkpoints' --exclude='*.msgpack' --exclude='*/models/*.json' \
-  $(ls -d */tuning.json */results report 2>/dev/null))
+python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" --results "$ROOT/report" --report \
+  --images "$IMAGES" $ARGS >> "$LOG" 2>&1
+tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
 (cd "$ROOT" && ls -d */*/seed*/models/"$IMAGES".* */*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
   | split -b 15M - "$OUT/models.tgz.")
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

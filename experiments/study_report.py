@@ -25,8 +25,8 @@ from lipjax.utils import written_whole
 PAIRS = (("lip-ad", "best end-to-end"), ("lip-ad", "lip-cnn"), ("lip-ad-fast", "best end-to-end"))
 
 
-def load_scores(root: pathlib.Path, scene: str) -> list[dict]:
-    folder = root / scene / "results"
+def load_scores(scores: pathlib.Path, scene: str) -> list[dict]:
+    folder = scores / scene
     return [json.loads(p.read_text()) for p in sorted(folder.glob("*-seed*-*.json"))] if folder.exists() else []
 
 
@@ -198,8 +198,8 @@ def write_report(study, out: pathlib.Path | None = None) -> dict:
     out.mkdir(parents=True, exist_ok=True)
     doc: dict = {"details": {"scores_left": missing(study)}}
     for scene in SCENES:
-        scores = load_scores(study.root, scene)
-        classical_path = study.root / scene / "results" / "classical.json"
+        scores = load_scores(study.scores, scene)
+        classical_path = study.scores_dir(scene) / "classical.json"
         classical = json.loads(classical_path.read_text()) if classical_path.exists() else {}
         if not scores:
             continue
@@ -208,7 +208,7 @@ def write_report(study, out: pathlib.Path | None = None) -> dict:
         best = best_end_to_end(summary)
         tests = [paired_test(scores, a, best if b == "best end-to-end" else b, study.images)
                  for a, b in PAIRS if (best or b != "best end-to-end")]
-        tuning_path = study.root / scene / "tuning.json"
+        tuning_path = study.scores_dir(scene) / "tuning.json"
         doc["details"][scene] = {
             "tuning_val_rmse_m": json.loads(tuning_path.read_text()) if tuning_path.exists() else {},
             "curve_rmse_m": curve(scores), "rmse_m_by_iterations": iterations(scores, study.images),

@@ -20,7 +20,7 @@ from lipjax.train.state import g_learning_rate
 def study(tmp_path, **kw):
     defaults = dict(scenes=("indoor",), seeds={"indoor": (0, 1)}, images=32, curve={"indoor": (16, 32, 48)},
                     tune_images=16, adv_images=8, limit=1, tiny=True)
-    return equal_budget.Study(tmp_path, **{**defaults, **kw})
+    return equal_budget.Study(tmp_path, tmp_path / "scores", **{**defaults, **kw})
 
 
 def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
@@ -106,11 +106,12 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
 
 def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(equal_budget, "TUNE_LRS", (5e-4, 1e-3))  # two rates: a choice, in fewer compiles
-    args = ["--tiny", "--root", str(tmp_path / "study"), "--results", str(tmp_path / "report"), "--scene", "indoor",
+    args = ["--tiny", "--root", str(tmp_path / "study"), "--scores", str(tmp_path / "scores"), "--results",
+            str(tmp_path / "report"), "--scene", "indoor",
             "--seeds", "0", "--images", "96", "--curve", "48,96", "--tune-images", "16", "--adv-images", "40",
             "--limit", "2", "--methods", "lip-cnn,lip-ad", "--no-progress"]
     equal_budget.main(args)
-    results = tmp_path / "study" / "indoor" / "results"
+    results = tmp_path / "scores" / "indoor"
     names = sorted(p.name for p in results.glob("*-seed*-*.json"))
     assert names == sorted(f"{m}-seed0-{n}.json" for m in ("lip-cnn", "lip-ad") for n in (48, 96))
     for name in names:  # each score is of a model that read exactly its budget
@@ -120,7 +121,7 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     k = str(lip["metrics"].get("iterations", 3))
     assert set(lip["rmse_m_by_iterations"]) == {"1", "2", "3"}  # Fig. 4a: every K of the 3-iteration solver
     assert lip["rmse_m_by_iterations"][k] == lip["rmse_m"]
-    tuning = json.loads((tmp_path / "study" / "indoor" / "tuning.json").read_text())["lip-cnn"]
+    tuning = json.loads((results / "tuning.json").read_text())["lip-cnn"]
     chosen = min(tuning, key=lambda lr: tuning[lr]["val_rmse_m"])  # the trunk ran at the rate tuning chose
     assert lipjax.load_model(lip["model"]).metadata["learning_rate"] == float(chosen)
     report = json.loads((tmp_path / "report" / "equal_budget.json").read_text())
