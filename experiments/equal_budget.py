@@ -77,6 +77,7 @@ class Study:
     tiny: bool = False
     methods: tuple[str, ...] = METHODS
     workers: int = 1  # loader processes of every run (data.num_workers: how fast, not what it reads)
+    warm_starts: pathlib.Path | None = WARM_STARTS  # committed workdirs to go on from (None: never; the tiny check)
 
     def __post_init__(self):
         for n in (self.images, self.tune_images, self.adv_images, *[c for cs in self.curve.values() for c in cs]):
@@ -147,11 +148,7 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
     final = max(study.budgets_for(scene, seed))  # the run's length is fixed by its seed's largest budget
     config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
                                        tiny=study.tiny), study.workers)
-    workdir = study.scene_dir(scene) / trunk / f"seed{seed}"
-    committed = WARM_STARTS / scene / trunk / f"seed{seed}"
-    if not workdir.exists() and committed.is_dir() and not study.tiny:  # a new machine: go on from the committed one
-        shutil.copytree(committed, workdir)
-        print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
+    workdir = trunk_workdir(study, scene, trunk, seed)
     for images in stops:
         if not _needed(study, scene, trunk, seed, images, budgets, wanted_branches):
             continue
@@ -167,6 +164,17 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
     for method in wanted_branches:
         for images in budgets:
             run_branch(study, scene, method, config, seed, images, progress)
+
+
+def trunk_workdir(study: Study, scene: str, trunk: str, seed: int) -> pathlib.Path:
+    """The run's workdir in --root; on a machine without it, a copy of the one committed under study.warm_starts
+    (the run that was in progress when a session ended), if any."""
+    workdir = study.scene_dir(scene) / trunk / f"seed{seed}"
+    committed = None if study.warm_starts is None else study.warm_starts / scene / trunk / f"seed{seed}"
+    if not workdir.exists() and committed is not None and committed.is_dir():
+        shutil.copytree(committed, workdir)
+        print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
+    return workdir
 
 
 def _needed(study: Study, scene: str, trunk: str, seed: int, images: int, budgets: list[int],
@@ -332,7 +340,8 @@ def main(argv=None) -> None:
         study = Study(pathlib.Path(args.root), pathlib.Path(args.scores), scenes,
                       {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
                       args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
-                      args.tune_images, args.adv_images, args.limit, args.tiny, methods, args.workers)
+                      args.tune_images, args.adv_images, args.limit, args.tiny, methods, args.workers,
+                      None if args.tiny else WARM_STARTS)
     except ValueError as exc:
         p.error(str(exc))
     from experiments.study_report import write_report

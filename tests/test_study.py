@@ -18,7 +18,8 @@ from lipjax.train.state import g_learning_rate
 
 
 def study(tmp_path, **kw):
-    defaults = dict(scenes=("indoor",), seeds={"indoor": (0, 1)}, images=32, curve={"indoor": (16, 32, 48)},
+    defaults = dict(warm_starts=None, scenes=("indoor",), seeds={"indoor": (0, 1)}, images=32,
+                    curve={"indoor": (16, 32, 48)},
                     tune_images=16, adv_images=8, limit=1, tiny=True)
     return equal_budget.Study(tmp_path, tmp_path / "scores", **{**defaults, **kw})
 
@@ -39,6 +40,19 @@ def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
         study(tmp_path, images=30)
     with pytest.raises(ValueError, match="below the smallest budget"):
         study(tmp_path, adv_images=16)
+
+
+def test_a_run_committed_to_go_on_from_is_copied_to_a_machine_without_it(tmp_path, capsys):
+    committed = tmp_path / "warm" / "indoor" / "unet" / "seed1"
+    (committed / "checkpoints" / "500").mkdir(parents=True)
+    (committed / "run.json").write_text("{}")
+    s = study(tmp_path, warm_starts=tmp_path / "warm")
+    workdir = equal_budget.trunk_workdir(s, "indoor", "unet", 1)
+    assert (workdir / "checkpoints" / "500").is_dir() and (workdir / "run.json").read_text() == "{}"
+    assert "continuing from" in capsys.readouterr().out
+    (workdir / "run.json").write_text("moved on")  # a workdir that exists is never replaced
+    assert (equal_budget.trunk_workdir(s, "indoor", "unet", 1) / "run.json").read_text() == "moved on"
+    assert not equal_budget.trunk_workdir(study(tmp_path, warm_starts=None), "indoor", "unet", 2).exists()
 
 
 def test_a_branch_reads_its_budget_of_images_on_a_stream_of_its_own():
