@@ -11,16 +11,16 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
     lipjax export [--model M] --height H --width W [--batch B] [--samples N] [--scattered] [--[no-]mirror] --out F
-    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--init NAME|PATH] [--steps N] [--keep best|last]
+    lipjax train --data FOLDER --out MODEL [--depth-scale S] [--steps N] [--keep best|last] [--self-supervised]
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
 
 Run `lipjax COMMAND --help` for a command's options.
 """
-# Each subcommand: `_add_<name>_parser`, and `_cmd_<name>(args)` calling one library function it imports (quick --help)
 from __future__ import annotations
 
 import argparse
+import functools
 import sys
 
 from lipjax import __version__, console
@@ -99,11 +99,14 @@ def _cmd_data_render(args) -> int:
 
 
 def _cmd_train(args) -> int:
+    from lipjax.train.adapt import adapt_folder
     from lipjax.train.run import fine_tune_folder
-    fine_tune_folder(args.data, args.out, init=args.init, steps=args.steps, batch_size=args.batch_size,
-                     workdir=args.workdir, progress=not args.quiet, log=None if args.quiet else console.say,
-                     depth_scale=args.depth_scale, num_workers=args.workers, crop=args.crop and tuple(args.crop),
-                     train_sampler=args.sampler, keep=args.keep)
+    hide = args.self_supervised  # None: fine-tune on depth/; a share: adapt by self-supervision
+    train = fine_tune_folder if hide is None else functools.partial(adapt_folder, hide=hide)
+    train(args.data, args.out, init=args.init, steps=args.steps, batch_size=args.batch_size,
+          workdir=args.workdir, progress=not args.quiet, log=None if args.quiet else console.say,
+          depth_scale=args.depth_scale, num_workers=args.workers, crop=args.crop and tuple(args.crop),
+          train_sampler=args.sampler, keep=args.keep)
     return 0
 
 
@@ -146,8 +149,7 @@ def _add_complete_parser(sub) -> None:
     out.add_argument("--out", help="X.npy | X.png | X.color.png, or a folder with folder inputs")
     c.add_argument("--out-format", choices=OUT_FORMATS, help="per-frame format with folder inputs")
     c.add_argument("--max-side", type=console.positive_int, metavar="N", help="run downsized to this longer side")
-    c.add_argument("--color-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"),
-                   help="metres mapped onto the colour map of .color.png (default 0 .. the model's max depth)")
+    c.add_argument("--color-range", type=float, nargs=2, metavar=("MIN_M", "MAX_M"), help="metres of .color.png's map")
     c.add_argument("--ply", help="also write a coloured point cloud (.ply; a folder with folder inputs)")
     _add_intrinsics_args(c, "pixels, of the RGB image", '"fx fy cx cy", the 9 numbers of K, or a calibration file')
     c.add_argument("--uncertainty", metavar="FILE", help="also write the expected absolute error (above)")
@@ -171,8 +173,7 @@ def _add_project_parser(sub) -> None:
     p.add_argument("--rgb", required=True, help="the camera's image (gives the size)")
     p.add_argument("--out", required=True,
                    help="SPARSE.npy (float32 metres) | .png (16-bit, value = metres * --depth-scale) | .color.png")
-    p.add_argument("--depth-scale", type=depth_scale, metavar="S",
-                   help="PNG value per metre of .png output (default 256, KITTI's)")
+    p.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG value per metre of .png (default 256)")
     p.add_argument("-q", "--quiet", action="store_true", help="no summary line")
     p.set_defaults(func=_cmd_project)
 
@@ -188,8 +189,7 @@ def _add_evaluate_parser(sub) -> None:
                       "[sparse/] (or train/ and val/ holding them): every frame, its sparse/ maps as input if any")
     data.add_argument("--source", choices=SOURCES, help="a training data source, read as training reads it; its "
                       "default protocol's crop and depth range unless --protocol says otherwise")
-    e.add_argument("--root", metavar="DIR",
-                   help="the folder of the --source data set (--source rendered: DIR[,DIR...], renders of one kind)")
+    e.add_argument("--root", metavar="DIR", help="the --source data set's folder (rendered: DIR[,DIR...], one kind)")
     e.add_argument("--raw-root", metavar="DIR", help="KITTI raw drives, for --source kitti_dc")
     e.add_argument("--split", choices=SPLITS, help="synthetic split (default test); FOLDER: "
                    "train or val as lipjax train splits it (default: every frame); --source: train|val (default val)")
@@ -200,8 +200,7 @@ def _add_evaluate_parser(sub) -> None:
                    "sparse/, else uniform:200")
     e.add_argument("--protocol", choices=sorted(PROTOCOLS) + [NO_PROTOCOL], help="named crop/resize + depth range "
                    "applied to each frame; none: frames as they are (with --source, still the source's depth range)")
-    e.add_argument("--depth-scale", type=depth_scale, metavar="S",
-                   help="PNG depth value per metre in FOLDER (or --source folder)")
+    e.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre in FOLDER")
     _add_intrinsics_args(e)
     e.add_argument("--working-size", action="store_true", help="score models as `lipjax complete` runs them: at "
                    "the samples' working size, measured pixels set back (default: at the input's size, as the tables)")
@@ -241,8 +240,7 @@ def _add_data_parser(sub) -> None:
     r.add_argument("--out", required=True, help="folder; re-running the same command finishes an interrupted render")
     r.add_argument("--height", type=console.positive_int, help="full frame (default 256x320 indoor, 128x416 outdoor)")
     r.add_argument("--width", type=console.positive_int)
-    r.add_argument("--window", type=console.positive_int, nargs=2, metavar=("H", "W"),
-                   help="store one HxW window per frame, rendered directly at the training crop size")
+    r.add_argument("--window", type=console.positive_int, nargs=2, metavar=("H", "W"), help="one HxW window a frame")
     r.add_argument("--workers", type=console.positive_int, help="processes (default: every core)")
     r.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     r.set_defaults(func=_cmd_data_render)
@@ -263,6 +261,8 @@ def _add_train_parser(sub) -> None:
     t.add_argument("--crop", type=console.positive_int, nargs=2, metavar=("H", "W"),
                    help=f"random training crops (default {TRAINING.crop[0]} {TRAINING.crop[1]})")
     t.add_argument("--workers", type=int, help=f"loader processes (0: none; default {TRAINING.workers})")
+    t.add_argument("--self-supervised", type=float, nargs="?", const=0.2, metavar="HIDE", help="rgb/ and sparse/ "
+                   "alone (no depth/): learn from a share HIDE (default 0.2) of each frame's samples hidden from it")
     t.add_argument("--keep", choices=("best", "last"), default="best", help="if the trained model validates worse "
                    "than its start: export the start (best, default) or the trained model anyway (last)")
     t.add_argument("--workdir", help="checkpoints and logs (default runs/train-<--out name>)")

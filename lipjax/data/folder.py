@@ -13,6 +13,8 @@ Folder layout (frames matched by file stem):
     <root>/intrinsics/<stem>.txt              optional, per frame, same format
 or <root>/train/ and <root>/val/, each laid out as <root> above: `lipjax train` trains on train/ and validates on
 val/ (without them, on all but the last 5 % of the frames and on that 5 %).
+A folder of rgb/ and sparse/ alone, without depth/ (your sensor without ground truth), adapts a model by
+self-supervision (lipjax.train.adapt: the loss at samples hidden from the input, lipjax.data.hidden).
 
 Depth scales of common sensors (raw PNG value per metre): KITTI 256, NYU / Kinect / RealSense 1000,
 TUM RGB-D 5000. A PNG depth has no unit in it, so the scale must be given: there is no default.
@@ -319,12 +321,16 @@ class FolderDataset:
       intrinsics_needed: False when nothing reads the intrinsics (only the LiDAR simulation of
         lipjax.data.sampling does): a folder without them is then no error, and its Samples carry
         UNUSED_INTRINSICS.
+      depth_dir: the folder of the Samples' depth: "depth", or SPARSE_DIR for a folder of RGB and sparse depth
+        alone (no depth/ needed), whose Samples' depth is their own sparse map: the self-supervised runs of
+        lipjax.data.hidden learn from samples hidden from the input.
     """
 
     def __init__(self, root: str | os.PathLike, depth_scale: float | None = None,
-                 intrinsics: Intrinsics | None = None, id_prefix: str | None = None, intrinsics_needed: bool = True):
+                 intrinsics: Intrinsics | None = None, id_prefix: str | None = None, intrinsics_needed: bool = True,
+                 depth_dir: str = "depth"):
         self.root = Path(root)
-        rgb_dir, depth_dir = self.root / "rgb", self.root / "depth"
+        rgb_dir, depth_dir = self.root / "rgb", self.root / depth_dir
         for directory in (rgb_dir, depth_dir):
             if not directory.is_dir():
                 raise dataset_error("Folder data set directory not found", directory, FOLDER_LAYOUT, FOLDER_SOURCE)

@@ -7,6 +7,10 @@ a permutation drawn from (seed, e) (or in order when shuffle=False). So batch s 
 (dataset, seed, s): a run resumed at step s yields exactly what the original run would have yielded from
 step s on, and every epoch has a different order.
 
+Self-supervision. A sampler that `withholds` its input (lipjax.data.hidden.HiddenInput) leaves each example's ground
+truth only where its input has no sample, before and after the augmentation; training draws its input anew each
+epoch (`redraw_each_epoch`: `redraw_seed`), still a pure function of (seed, s).
+
 Workers. `TrainLoader` runs the whole per-step work (reading, sampling, augmentation and crop, the host z0
 fill) in `num_workers` grain worker processes (grain.IterDataset.mp_prefetch): element s of its grain
 MapDataset is this process's batch of step s, so the worker count changes the speed, never the batches.
@@ -28,6 +32,7 @@ from typing import Any, Iterator, Sequence
 import numpy as np
 
 from lipjax.data.augment import Augment, augment_batch
+from lipjax.data.hidden import without_input
 from lipjax.data.sample import Batch, Sample
 from lipjax.data.sampling import SparseSampler
 from lipjax.utils import exit_when_orphaned
@@ -105,19 +110,28 @@ class BatchIterator:
         per = len(indices) // self.process_count
         return indices[self.process_index * per : (self.process_index + 1) * per]
 
-    def example(self, index: int) -> tuple[Sample, np.ndarray]:
-        """(protocol-applied Sample, (H, W) float32 sparse depth in metres) of dataset[index]."""
+    def example(self, index: int, epoch: int | None = None) -> tuple[Sample, np.ndarray]:
+        """(protocol-applied Sample, (H, W) float32 sparse depth in metres) of dataset[index]. A sampler that
+        `withholds` its input from the ground truth (lipjax.data.hidden.HiddenInput) gives a Sample whose ground truth
+        is where the input has no sample (lipjax.data.hidden.without_input); one that asks to `redraw_each_epoch`
+        draws with `redraw_seed` of `epoch` (training; None: sample_seed, as validation draws)."""
         sample = self.dataset[int(index)]
         if self.protocol is not None:
             sample = self.protocol(sample)
-        sparse = np.asarray(self.sampler(sample, self.sample_seed), dtype=np.float32)
+        seed = self.sample_seed
+        if epoch is not None and getattr(self.sampler, "redraw_each_epoch", False):
+            seed = redraw_seed(self.sample_seed, self.seed, epoch)
+        sparse = np.asarray(self.sampler(sample, seed), dtype=np.float32)
         if sparse.shape != sample.shape:
             raise ValueError(f"sampler returned {sparse.shape} for {sample.id!r} of shape {sample.shape}")
+        if getattr(self.sampler, "withholds", False):
+            sample = without_input(sample, sparse)
         return sample, sparse
 
     def examples(self, step: int) -> list[tuple[Sample, np.ndarray]]:
         """This process's examples of global step `step`, as `example` gives them (frames of any sizes)."""
-        return [self.example(i) for i in self.local_indices(step)]
+        epoch = self.position(step)[0]
+        return [self.example(i, epoch) for i in self.local_indices(step)]
 
     def batch(self, step: int) -> Batch:
         """This process's Batch of global step `step` (a pure function of the step); its frames must share one
@@ -139,6 +153,12 @@ class BatchIterator:
         while self.end_step is None or step < self.end_step:
             yield self.batch(step)
             step += 1
+
+
+def redraw_seed(sample_seed: int, seed: int, epoch: int) -> int:
+    """The sampler's seed in `epoch` of a run of shuffle seed `seed`, for samplers that draw new samples each epoch
+    (`redraw_each_epoch`): a pure function of the three, so that batch s stays a pure function of (seed, s)."""
+    return int(np.random.SeedSequence([sample_seed, seed, epoch]).generate_state(1)[0])
 
 
 def stacked(examples: list[tuple[Sample, np.ndarray]], what: str = "a batch") -> Batch:
@@ -212,6 +232,9 @@ class StepBatches:
                                                                           for p in parts))))
         else:
             batch = augment_batch(stacked(examples, f"step {step}"), self.augment, self.crop, self.seed, step, first)
+        if getattr(self.iterator.sampler, "withholds", False):  # no ground truth where a zoom put an input sample
+            keep = batch.gt_valid & (batch.sparse <= 0)
+            batch = dataclasses.replace(batch, gt=np.where(keep, batch.gt, 0).astype(np.float32), gt_valid=keep)
         return {"step": np.int64(step), **with_host_inputs(self.model_config, batch).as_dict()}
 
 

@@ -15,7 +15,9 @@
 
 Sparse input: a sampler spec of lipjax.data.sampling ("uniform:200", "lidar:hdl64", mixtures "a|b"), or
 "input" / "input:N" for the data set's own sparse input: KITTI's real `velodyne_raw` scan, or a folder's
-sparse/<stem> maps (same format and depth scale as depth/); ":N" keeps exactly N of its points.
+sparse/<stem> maps (same format and depth scale as depth/); ":N" keeps exactly N of its points. "hide" / "hide:F"
+(a folder only, self-supervised: lipjax.data.hidden): the folder's sparse/ maps are its ground truth (no depth/
+needed), each frame's input is its sparse map less a share F of it, the hidden samples its ground truth.
 
 Depth in metres throughout; `DataConfig` (lipjax.train.config) names the source, its root and the rest.
 """
@@ -30,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from lipjax.data.errors import dataset_error
+from lipjax.data.hidden import AtWorkingSize, HiddenInput, hide_share
 from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
@@ -88,15 +91,21 @@ class FolderInput:
     num_points: int | None = None
 
     def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        from lipjax.data.folder import read_depth
-
-        path = self._path(sample.id[len(self.id_prefix) + 1:])
-        sparse = read_depth(path, self.depth_scale if path.suffix.lower() == ".png" else None)
+        sparse = self.read(sample.id)
         if sparse.shape != sample.shape:
-            raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ", path)
+            raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ",
+                                self._path(sample.id[len(self.id_prefix) + 1:]))
         if self.num_points is not None:
             sparse = subsample_exact(sparse, self.num_points, example_rng(seed, sample.id))
         return sparse
+
+    def read(self, sample_id: str) -> np.ndarray:
+        """The whole sparse map (H, W) float32 metres of the frame whose Sample.id is `sample_id`, unchecked against
+        any size (lipjax.data.hidden.HiddenInput reads it at full size for a Sample at its working size)."""
+        from lipjax.data.folder import read_depth
+
+        path = self._path(sample_id[len(self.id_prefix) + 1:])
+        return read_depth(path, self.depth_scale if path.suffix.lower() == ".png" else None)
 
     def _path(self, key: str) -> Path:
         """sparse/<key>.png|.npy; for frames paired by number (key "00050": rgb_00050.jpg with
@@ -126,9 +135,9 @@ def own_points(spec: str) -> int | None:
 
 
 def uses_intrinsics(spec: str) -> bool:
-    """Whether the sparse input of `spec` (a lipjax.data.sampling spec, or "input[:N]") reads the camera
+    """Whether the sparse input of `spec` (a lipjax.data.sampling spec, "input[:N]" or "hide[:F]") reads the camera
     intrinsics: only the LiDAR simulation does."""
-    return spec.split(":")[0].strip() != OWN_INPUT and draws_scan_lines(spec)
+    return spec.split(":")[0].strip() != OWN_INPUT and hide_share(spec) is None and draws_scan_lines(spec)
 
 
 def folder_split_root(root: Path, split: str) -> tuple[Path, bool]:
@@ -209,9 +218,11 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
 
         folder, own_split = folder_split_root(Path(root), split)
         spec = data.train_sampler if split == "train" else data.val_sampler
+        hide = hide_share(spec) is not None  # rgb/ and sparse/ alone, at the working size (lipjax.data.hidden)
         dataset = FolderDataset(folder, depth_scale=data.depth_scale, id_prefix=f"folder/{split}",
-                                intrinsics_needed=uses_intrinsics(spec))
+                                intrinsics_needed=uses_intrinsics(spec), depth_dir=SPARSE_DIR if hide else "depth")
         own = FolderInput(os.fspath(folder / SPARSE_DIR), data.depth_scale, dataset.id_prefix)
+        dataset = ProtocolView(dataset, AtWorkingSize()) if hide else dataset
         if own_split:
             return dataset, own
         return Subset(dataset, tail_split(["all"] * len(dataset), split)), own
@@ -249,7 +260,12 @@ def open_source(data: Any, split: str, *, render_frames: bool = False) -> Source
     dataset, own = _raw_dataset(data, split, render_frames)
     protocol = applied_protocol(data)
     spec = data.train_sampler if split == "train" else data.val_sampler
-    if spec.split(":")[0].strip() == OWN_INPUT:
+    if hide_share(spec) is not None:
+        if data.source != "folder":
+            raise ValueError(f"sampler {spec!r} (self-supervised: samples hidden from a folder's own sparse/ maps) "
+                             f"needs data.source='folder', got {data.source!r}")
+        sampler = HiddenInput(own, hide_share(spec))
+    elif spec.split(":")[0].strip() == OWN_INPUT:
         if own is None:
             raise ValueError(f"sampler {spec!r}: data.source={data.source!r} has no sparse input of its own; "
                              "use a spec such as uniform:200")

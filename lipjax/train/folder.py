@@ -48,8 +48,9 @@ def folder_config(model, init_from: str | None, *, name: str = "lip-cnn-folder",
 
 def default_init(**data) -> tuple[str, str, str]:
     """The model `lipjax train` fine-tunes by default: the shipped default model (lipjax.shipped.DEFAULT_MODELS) of
-    the scene that the first training frame's input suggests (lipjax.inputs.scene_reason), as `lipjax complete`
-    picks it. data: DataConfig fields over FOLDER_DATA, as folder_config takes them.
+    the scene that the first training frame's input suggests (lipjax.inputs.scene_reason); both scenes' is lip-any,
+    the model `lipjax complete` runs on every input. data: DataConfig fields over FOLDER_DATA, as folder_config takes
+    them.
 
     Returns (model name, scene, the evidence in words)."""
     from lipjax.data.sources import open_source
@@ -95,19 +96,21 @@ def own_input_validation(data: dict) -> dict:
 
 def check_frames(data: DataConfig) -> int:
     """Reads every frame of a folder source once (RGB, depth, intrinsics, sizes; and sparse/ when a sampler is
-    "input"), both splits, in threads. Returns the number of frames; raises one DatasetError naming every
-    unreadable file (path relative to data.root and the reason), so that a bad file stops the run before
-    training rather than at the step that first draws it."""
+    "input"), both splits, in threads; a self-supervised run's ("hide[:F]": lipjax.data.hidden) rgb/ and sparse/.
+    Returns the number of frames; raises one DatasetError naming every unreadable file (path relative to data.root
+    and the reason), so that a bad file stops the run before training rather than at the step that first draws it."""
     from lipjax.data.folder import SPARSE_DIR, FolderDataset, read_depth
+    from lipjax.data.hidden import hide_share
     from lipjax.data.sources import folder_split_root, uses_intrinsics
 
     root = Path(data.root).resolve()
     folders = {folder_split_root(root, split)[0] for split in ("train", "val")}
     own_input = "input" in f"{data.train_sampler}|{data.val_sampler}"
     needed = uses_intrinsics(data.train_sampler) or uses_intrinsics(data.val_sampler)
+    depth_dir = SPARSE_DIR if hide_share(data.train_sampler) is not None else "depth"
     jobs = []
     for folder in sorted(folders):
-        dataset = FolderDataset(folder, depth_scale=data.depth_scale, intrinsics_needed=needed)
+        dataset = FolderDataset(folder, depth_scale=data.depth_scale, intrinsics_needed=needed, depth_dir=depth_dir)
         jobs += [functools.partial(dataset.__getitem__, i) for i in range(len(dataset))]
         own = folder / SPARSE_DIR
         sparse = sorted(own.glob("*.*")) if own_input and own.is_dir() else []
