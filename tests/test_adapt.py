@@ -184,7 +184,7 @@ def test_one_frame_adapts_on_itself(tmp_path):
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--self-supervised", "--sampler", "uniform:200"], "lipjax: error: train_sampler='uniform:200': a self-supervised"),
+    (["--self-supervised", "--sampler", "uniform:200"], "lipjax: error: train_sampler='uniform:200': a self-"),
     (["--self-supervised", "1.5"], "lipjax: error: hide=1.5: the share of each frame's samples hidden"),
 ])
 def test_lipjax_train_self_supervised_refuses_a_sampler_and_a_share_outside_0_1(tmp_path, capsys, argv, message):
