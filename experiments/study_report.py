@@ -116,8 +116,14 @@ def markdown(doc: dict, images: int) -> str:
                   "| method | images | seeds | RMSE m | MAE m | RMSE / linear | RMSE m by training images, mean over "
                   "seeds |",
                   "|---|---:|---|---:|---:|---:|---|"]
-        for method, row in summary.items():
-            if "seeds" in row:
+        rows = {m: summary.get(m, {"curve only": True}) for m in METHODS if m in summary or m in curves}
+        rows.update({m: row for m, row in summary.items() if m not in METHODS})
+        for method, row in rows.items():
+            if "curve only" in row:  # scored on the way, not yet at the budget
+                curve_text = ", ".join(f"{int(n):,}: {statistics.mean(v):.3f}"
+                                       for n, v in sorted(curves[method].items(), key=lambda kv: int(kv[0])))
+                lines.append(f"| {method} | not yet | | | | | {curve_text} |")
+            elif "seeds" in row:
                 ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
                 curve_text = ", ".join(f"{int(n):,}: {statistics.mean(v):.3f}"
                                        for n, v in sorted(curves.get(method, {}).items(), key=lambda kv: int(kv[0])))
