@@ -32,7 +32,7 @@ from typing import Any, Iterator, Sequence
 import numpy as np
 
 from lipjax.data.augment import Augment, augment_batch
-from lipjax.data.hidden import without_input
+from lipjax.data.hidden import HiddenInput, without_input
 from lipjax.data.sample import Batch, Sample
 from lipjax.data.sampling import SparseSampler
 from lipjax.utils import exit_when_orphaned
@@ -119,12 +119,12 @@ class BatchIterator:
         if self.protocol is not None:
             sample = self.protocol(sample)
         seed = self.sample_seed
-        if epoch is not None and getattr(self.sampler, "redraw_each_epoch", False):
+        if epoch is not None and isinstance(self.sampler, HiddenInput) and self.sampler.redraw_each_epoch:
             seed = redraw_seed(self.sample_seed, self.seed, epoch)
         sparse = np.asarray(self.sampler(sample, seed), dtype=np.float32)
         if sparse.shape != sample.shape:
             raise ValueError(f"sampler returned {sparse.shape} for {sample.id!r} of shape {sample.shape}")
-        if getattr(self.sampler, "withholds", False):
+        if isinstance(self.sampler, HiddenInput) and self.sampler.withholds:
             sample = without_input(sample, sparse)
         return sample, sparse
 
@@ -232,7 +232,8 @@ class StepBatches:
                                                                           for p in parts))))
         else:
             batch = augment_batch(stacked(examples, f"step {step}"), self.augment, self.crop, self.seed, step, first)
-        if getattr(self.iterator.sampler, "withholds", False):  # no ground truth where a zoom put an input sample
+        sampler = self.iterator.sampler
+        if isinstance(sampler, HiddenInput) and sampler.withholds:  # no ground truth where a zoom put an input sample
             keep = batch.gt_valid & (batch.sparse <= 0)
             batch = dataclasses.replace(batch, gt=np.where(keep, batch.gt, 0).astype(np.float32), gt_valid=keep)
         return {"step": np.int64(step), **with_host_inputs(self.model_config, batch).as_dict()}
