@@ -114,7 +114,7 @@ from lipjax.data.synthetic.dataset import (
 from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import render_scene
 from lipjax.data.synthetic.scene import Scene
-from lipjax.data.synthetic.scenes import build_scene
+from lipjax.data.synthetic.build import build_scene
 
 __all__ = [
     "SYNTHETIC_KINDS",

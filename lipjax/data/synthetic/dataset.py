@@ -29,7 +29,7 @@ from lipjax.data.synthetic.clutter import add_clutter
 from lipjax.data.synthetic.foliage import porous_foliage
 from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import Reflection, render_scene
-from lipjax.data.synthetic.scenes import build_scene
+from lipjax.data.synthetic.build import build_scene
 
 
 @dataclasses.dataclass(frozen=True)
