@@ -76,7 +76,7 @@ noise, colours); `patterns`, `materials` (textures); `geometry`, `primitives` (i
 scene elements, each a builder with its parameter ranges in a frozen dataclass: `room_materials`, `furniture`,
 `indoor` (room shell, decals, camera, furniture placement, ceiling lights); `street` (the layout), `road`,
 `vegetation`, `buildings`, `cars`, `sky`, `outdoor` (hills, poles and signs, pedestrians, camera);
-`scenes` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
+`build` (`build_scene(kind, rng)`); `visibility`, `surfaces`, `shadows`, `renderer` (ray casting, shading:
 `render_scene`, floor reflections on request: `Reflection`); `far_view` (windows onto streets in rooms); `clutter`
 (things on a room's floor, on request); `foliage` (porous trees and bushes, on request); `dataset` (the public
 entry points: seeds, checks, `render`).
