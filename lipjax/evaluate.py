@@ -13,7 +13,7 @@
 `open_eval_data` opens what `lipjax evaluate --data` or `--source` names (the synthetic scenes, a folder, a training
 source) in one place; `evaluate_methods` scores every method on it.
 
-Protocol, in one place:
+The evaluation protocol, in one place:
   - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
     sample id and this seed, so every method sees the same inputs and reruns are identical;
   - metrics are per image over valid ground truth in (min_depth_m, max_depth_m], then averaged over images
@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from lipjax.interfaces import DepthCompleter
-from lipjax.data.protocols import Protocol
+from lipjax.data.protocols import EvalProtocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import DEFAULT_SAMPLER
 from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol
@@ -114,7 +114,7 @@ def open_eval_source(
     raw_root: str | os.PathLike | None = None,
     depth_scale: float | None = None,
     kind: str | None = None,
-) -> tuple[Source, Protocol | None]:
+) -> tuple[Source, EvalProtocol | None]:
     """Every frame of `split` of a training source, read by the code training reads it with
     (lipjax.data.sources.open_source), and the protocol whose depth range its evaluation uses.
 
@@ -223,7 +223,7 @@ class EvalData:
     sampler: Sampler
     spec: str
     name: str
-    range_from: Protocol | None
+    range_from: EvalProtocol | None
 
 
 def _check_eval_args(data: str | None, source: str | None, root, raw_root, split, kind, size, intrinsics) -> None:

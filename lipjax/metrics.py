@@ -5,7 +5,7 @@ Evaluated pixels of one image (the evaluation mask E):
     E = valid & isfinite(gt) & (min_depth_m < gt <= max_depth_m)
 
 (lower bound exclusive, upper inclusive). The named protocols of lipjax.data.protocols carry the ranges to pass
-here (Protocol.min_depth_m, max_depth_m), e.g. NYU (0, 10] m, outdoor (0, 80] m.
+here (EvalProtocol.min_depth_m, max_depth_m), e.g. NYU (0, 10] m, outdoor (0, 80] m.
 
 Per image, with d = prediction and g = ground truth (metres), over the pixels of E:
 

@@ -18,7 +18,7 @@ from lipjax.data.kitti import (
     intrinsics_from_calib,
 )
 from lipjax.data.nyu import NYU_INTRINSICS, NyuH5Dataset, NyuTfdsDataset
-from lipjax.data.protocols import BottomCrop, Protocol
+from lipjax.data.protocols import BottomCrop, EvalProtocol
 from lipjax.data.sample import Intrinsics
 from lipjax.data.tartanair import TARTANAIR_INTRINSICS, TARTANAIR_MAX_VALID_DEPTH_M, TartanAirDataset
 
@@ -179,7 +179,7 @@ def test_kitti_depth_completion(tmp_path):
     # The scan as ground truth (Ma & Karaman's odometry protocol), and as a sampler with exactly N points.
     assert np.array_equal(KittiDepthCompletion(depth_root, raw_root, "val", target="velodyne_raw")[4].depth,
                           frame.lidar)
-    crop = Protocol("tiny", (BottomCrop(8, 12),), (8, 12), 0.0, 80.0)
+    crop = EvalProtocol("tiny", (BottomCrop(8, 12),), (8, 12), 0.0, 80.0)
     cropped = crop(s)
     real = KittiLidarInput(ds, crop)(cropped)
     assert np.array_equal(real, frame.lidar[4:, 2:14]) and np.array_equal(crop.apply_to_depth(frame.lidar), real)

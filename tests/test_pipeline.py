@@ -11,7 +11,7 @@ import pytest
 
 from lipjax.data.augment import Augment
 from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader
-from lipjax.data.protocols import Protocol, Resize
+from lipjax.data.protocols import EvalProtocol, Resize
 from lipjax.data.sample import Batch, Intrinsics, Sample
 from lipjax.data.sampling import UniformSampler
 
@@ -85,7 +85,7 @@ def test_finite_epochs_and_drop_last():
 
 
 def test_protocol_and_sparse_seed():
-    tiny = Protocol("tiny", (Resize(3, 4),), (3, 4), 0.0, 10.0)
+    tiny = EvalProtocol("tiny", (Resize(3, 4),), (3, 4), 0.0, 10.0)
     batch = make(protocol=tiny).batch(0)
     assert batch.gt.shape == (3, 3, 4)
     a, b = make(sample_seed=0).batch(0), make(sample_seed=1).batch(0)

@@ -12,7 +12,7 @@ from lipjax.data.protocols import (
     PROTOCOLS,
     BottomCrop,
     CenterCrop,
-    Protocol,
+    EvalProtocol,
     Resize,
     get_protocol,
     nearest_indices,
@@ -154,7 +154,7 @@ def test_steps_errors_and_nearest_indices():
     with pytest.raises(ValueError, match="at least"):
         CenterCrop(500, 640).apply(index_sample(480, 640, K_NYU))
     with pytest.raises(ValueError, match="expected"):
-        Protocol("bad", (BottomCrop(10, 10),), (20, 20), 0, 1)(index_sample(30, 30, K_NYU))
+        EvalProtocol("bad", (BottomCrop(10, 10),), (20, 20), 0, 1)(index_sample(30, 30, K_NYU))
     assert nearest_indices(4, 2).tolist() == [1, 3]
     assert nearest_indices(3, 6).tolist() == [0, 0, 1, 1, 2, 2]
     assert Resize(5, 5).apply(index_sample(5, 5, K_NYU)).intrinsics == K_NYU

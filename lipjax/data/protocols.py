@@ -139,7 +139,7 @@ class Resize:
 
 
 @dataclasses.dataclass(frozen=True)
-class Protocol:
+class EvalProtocol:
     """A named benchmark protocol.
 
     Attributes:
@@ -186,42 +186,42 @@ PAPER_SIZE = (256, 320)
 EVAL_MAX_DEPTH_INDOOR_M = 10.0
 EVAL_MAX_DEPTH_OUTDOOR_M = 80.0
 
-NYU_PAPER = Protocol(
+NYU_PAPER = EvalProtocol(
     "nyu_paper", (CenterCrop(*NYU_PAPER_CROP), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "NYU v2 480x640 -> centre crop 464x580 (drops the white border, aspect 0.8) -> resize 256x320 (scale 0.5517).",
 )
-NYU_MA = Protocol(
+NYU_MA = EvalProtocol(
     "nyu_ma", (Resize(240, 320), CenterCrop(228, 304)), (228, 304), 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "Ma & Karaman 2018 / CSPN / NLSPN: resize 480x640 -> 240x320, centre crop 228x304.",
 )
-KITTI_PAPER = Protocol(
+KITTI_PAPER = EvalProtocol(
     "kitti_paper", (BottomCrop(256, 1216),), (256, 1216), 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "KITTI DC, bottom crop 256x1216 (the paper removes the top rows without LiDAR), columns centred.",
 )
-KITTI_SELECTION = Protocol(
+KITTI_SELECTION = EvalProtocol(
     "kitti_selection", (BottomCrop(352, 1216),), (352, 1216), 0.0, math.inf,
     "KITTI depth_selection crop 352x1216 (bottom, columns centred); all GT > 0 counts, as the official devkit.",
 )
-TARTANAIR = Protocol(
+TARTANAIR = EvalProtocol(
     "tartanair", (CenterCrop(480, 600), Resize(*PAPER_SIZE)), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "TartanAir 480x640 -> centre crop 480x600 -> resize 256x320 (isotropic 0.5333), the NYU paper size.",
 )
-SYNTHETIC_INDOOR = Protocol(
+SYNTHETIC_INDOOR = EvalProtocol(
     "synthetic_indoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_INDOOR_M,
     "Embedded procedural indoor scenes, rendered at 256x320 (identity).",
 )
-SYNTHETIC_OUTDOOR = Protocol(
+SYNTHETIC_OUTDOOR = EvalProtocol(
     "synthetic_outdoor", (Resize(*PAPER_SIZE),), PAPER_SIZE, 0.0, EVAL_MAX_DEPTH_OUTDOOR_M,
     "Embedded procedural outdoor scenes, rendered at 256x320 (identity).",
 )
 
-PROTOCOLS: dict[str, Protocol] = {
+PROTOCOLS: dict[str, EvalProtocol] = {
     p.name: p
     for p in (NYU_PAPER, NYU_MA, KITTI_PAPER, KITTI_SELECTION, TARTANAIR, SYNTHETIC_INDOOR, SYNTHETIC_OUTDOOR)
 }
 
 
-def get_protocol(name: str) -> Protocol:
+def get_protocol(name: str) -> EvalProtocol:
     """Looks a protocol up by name, with the list of names in the error."""
     try:
         return PROTOCOLS[name]
@@ -280,7 +280,7 @@ def tartanair_split(trajectories: Sequence[str], frame_counts: Sequence[int] | N
 class ProtocolView:
     """An indexable data set seen through a protocol: view[i] = protocol(dataset[i]) (lazy, nothing cached)."""
 
-    def __init__(self, dataset: Any, protocol: "Protocol | str"):
+    def __init__(self, dataset: Any, protocol: "EvalProtocol | str"):
         self.dataset = dataset
         self.protocol = get_protocol(protocol) if isinstance(protocol, str) else protocol
 

@@ -33,7 +33,7 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.hidden import AtWorkingSize, HiddenInput, hide_share
-from lipjax.data.protocols import Protocol, ProtocolView, get_protocol
+from lipjax.data.protocols import EvalProtocol, ProtocolView, get_protocol
 from lipjax.data.sample import Sample
 from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
 from lipjax.interfaces import MIXED_SCENES
@@ -229,14 +229,14 @@ def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[An
     raise ValueError(f"unknown data.source {source!r}; choose one of {SOURCES}")
 
 
-def applied_protocol(data: Any) -> Protocol | None:
+def applied_protocol(data: Any) -> EvalProtocol | None:
     """The protocol open_source applies to a DataConfig's frames: data.protocol, else the source's default; None
     for data.protocol="none" or a source without one."""
     name = data.protocol or DEFAULT_PROTOCOLS.get(data.source)
     return get_protocol(name) if name not in (None, NO_PROTOCOL) else None
 
 
-def range_protocol(data: Any) -> Protocol | None:
+def range_protocol(data: Any) -> EvalProtocol | None:
     """The protocol whose depth range evaluation on a DataConfig's frames uses: the applied one, else (frames as
     they are, data.protocol="none") the source's default, synthetic_<data.kind> for the synthetic scenes; None for
     a folder."""
