@@ -16,7 +16,7 @@ expected error). Columns: Spearman rho between expected and actual |error|, pool
 setting and the mean of per-frame values; mean actual and expected |error| (m); the share of scored pixels
 "above the samples" (lipjax.uncertainty) and their mean actual |error| against the other pixels'.
 
---calibrate fits SPREAD_GAIN (least squares of |error| / z on the supported pixels)
+--calibrate fits RANGE_GAIN (least squares of |error| / z on the supported pixels)
 and ABOVE_GAIN (least squares of |error| = gain * z above the samples) on the synthetic VALIDATION splits,
 never on test or real frames, and prints them.
 """
@@ -59,7 +59,7 @@ def real_settings(root: str):
 
 
 def frame_rows(method, sample, sampler, depth_range):
-    """(features, |error|) of one frame's scored pixels: columns r, spread (m), height above (spacings), z (m),
+    """(features, |error|) of one frame's scored pixels: columns r, depth range (m), height above (spacings), z (m),
     expected error (m)."""
     sparse = sampler(sample, 0)
     depth = np.asarray(method(sample.rgb, sparse), np.float32)
@@ -67,7 +67,7 @@ def frame_rows(method, sample, sampler, depth_range):
     u = uncertainty.expected_error(sparse, depth)
     gt = sample.depth
     scored = sample.valid & (gt > depth_range[0]) & (gt <= depth_range[1]) & (sparse == 0)
-    cols = [f["distance"], f["spread"], f["height_above"], depth, u]
+    cols = [f["distance"], f["depth_range"], f["height_above"], depth, u]
     return np.stack([c[scored] for c in cols], axis=1), np.abs(depth - gt)[scored]
 
 
@@ -90,25 +90,25 @@ def run(settings, method_names):
 
 
 def calibrate(settings, method_names):
-    """Fits and prints SPREAD_GAIN and ABOVE_GAIN (see the module docstring). Every (setting, method)
+    """Fits and prints RANGE_GAIN and ABOVE_GAIN (see the module docstring). Every (setting, method)
     weighs the same in the fit of the supported pixels, whatever its pixel count."""
     design, target, above_err, above_z = [], [], [], []
     for _, scene, frames, sampler, depth_range in settings:
         for name in method_names:
             method = get_completer(name.format(scene=scene))
             x, err = map(np.concatenate, zip(*(frame_rows(method, s, sampler, depth_range) for s in frames)))
-            r, spread, height, z = x[:, 0], x[:, 1], x[:, 2], np.maximum(x[:, 3], 1e-3)
+            r, depth_range, height, z = x[:, 0], x[:, 1], x[:, 2], np.maximum(x[:, 3], 1e-3)
             supported = height <= 1.0
             weight = 1.0 / np.sqrt(supported.sum())
-            design.append(weight * (r * spread / z)[supported])
+            design.append(weight * (r * depth_range / z)[supported])
             target.append(weight * (err / z)[supported])
             above_err.append(err[~supported])
             above_z.append(z[~supported])
     design, target = np.concatenate(design), np.concatenate(target)
-    spread_gain = float(design @ target / (design @ design))  # least squares of |error| / z = gain * r * spread / z
+    range_gain = float(design @ target / (design @ design))  # least squares: |error| / z = gain * r * range / z
     above_err, above_z = np.concatenate(above_err), np.concatenate(above_z)
     above_gain = float(np.sum(above_err * above_z) / np.sum(above_z**2))  # least squares of |error| = gain * z
-    print(f"SPREAD_GAIN = {spread_gain:.4f}\nABOVE_GAIN = {above_gain:.4f}")
+    print(f"RANGE_GAIN = {range_gain:.4f}\nABOVE_GAIN = {above_gain:.4f}")
 
 
 def main(argv=None) -> None:

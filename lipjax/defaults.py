@@ -92,9 +92,9 @@ P_VALUE = 0.05
 SEED = 0
 
 # ---- the expected error and the support mask (lipjax.uncertainty), fitted on the synthetic validation splits
-# expected |error| per metre of nearby sample depth spread and per spacing of distance
+# expected |error| per metre of the nearby samples' depth range and per spacing of distance
 #   python -m benchmarks.uncertainty --calibrate
-SPREAD_GAIN = 0.1217
+RANGE_GAIN = 0.1217
 # expected |error| per metre of depth above the highest samples
 #   python -m benchmarks.uncertainty --calibrate
 ABOVE_GAIN = 0.1613

@@ -10,22 +10,22 @@ pixel is from its samples and with the depth jumps among those samples. With, pe
 
     s      the typical sample spacing (pixels): sqrt(area of the samples' bounding box / number of samples);
     r      the distance to the nearest sample in units of s (Euclidean, pixels / s);
-    spread the range (max - min, metres) of the nearest-sample depths within about 2 s: a depth edge nearby;
+    d      the depth range (max - min, metres) of the nearest-sample depths within about 2 s: a depth edge nearby;
     z      the completed depth (metres);
 
-    u = SPREAD_GAIN * r * spread                                supported pixels
+    u = RANGE_GAIN * r * d                                       supported pixels
     u = max(ABOVE_GAIN * z, the frame's largest supported u)     pixels more than one spacing above the highest
                                                                  sample of their columns (sky and anything above
                                                                  the top LiDAR beam)
 
 so pixels without support always come out as the most uncertain of the frame, and elsewhere u grows with the
 distance to the samples and with the depth jumps among them (and so with depth: far scenes have larger jumps).
-A fronto-parallel surface (no spread) gets 0, as any fill reproduces it; a slanted one (a floor, a road) does not.
+A fronto-parallel surface (no depth range) gets 0, as any fill reproduces it; a slanted one (a floor, a road) does not.
 "The highest sample of a column" is the highest sample within about 2 s columns (LiDAR scan lines have gaps;
 scattered samples are rarely in the same column).
 
 The constants were fitted on the synthetic VALIDATION splits (first 20 frames: indoor 200 uniform points,
-outdoor HDL-64 pattern; completions by `linear` and the shipped `lip-cnn-*` models): SPREAD_GAIN by least
+outdoor HDL-64 pattern; completions by `linear` and the shipped `lip-cnn-*` models): RANGE_GAIN by least
 squares of |error| / z on the supported pixels (an extra term in r**2 * z was tried and fitted to 0), ABOVE_GAIN
 by least squares of |error| = gain * z above the samples. `python -m benchmarks.uncertainty --calibrate` refits
 them; the same script reports the rank correlation with the actual error on the test splits and real frames.
@@ -40,7 +40,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from lipjax.defaults import ABOVE_GAIN, ABOVE_SPACINGS, REACH_SPACINGS, SPREAD_GAIN  # why, benchmark: there
+from lipjax.defaults import ABOVE_GAIN, ABOVE_SPACINGS, REACH_SPACINGS, RANGE_GAIN  # why, benchmark: there
 from lipjax.utils import written_whole
 
 
@@ -81,7 +81,7 @@ def _column_tops(measured: np.ndarray, s: float) -> np.ndarray:
 def support_features(sparse: np.ndarray) -> dict[str, np.ndarray | float]:
     """What the estimate is made of, for one (H, W) sparse map in metres (0 = no sample).
 
-    Returns {"spacing": s (pixels), "distance": r (H, W) in spacings, "spread": (H, W) metres,
+    Returns {"spacing": s (pixels), "distance": r (H, W) in spacings, "depth_range": (H, W) metres,
     "height_above": (H, W) spacings above the highest sample of the column (<= 0 at or below it)}.
     """
     sparse = np.asarray(sparse, np.float32)
@@ -92,9 +92,9 @@ def support_features(sparse: np.ndarray) -> dict[str, np.ndarray | float]:
     distance, (ri, ci) = ndimage.distance_transform_edt(~measured, return_indices=True)
     nearest = sparse[ri, ci]
     window = 2 * math.ceil(2 * s) + 1
-    spread = ndimage.maximum_filter(nearest, window) - ndimage.minimum_filter(nearest, window)
+    depth_range = ndimage.maximum_filter(nearest, window) - ndimage.minimum_filter(nearest, window)
     height_above = (_column_tops(measured, s)[None, :] - np.arange(sparse.shape[0])[:, None]) / s
-    return {"spacing": s, "distance": distance / s, "spread": spread, "height_above": height_above}
+    return {"spacing": s, "distance": distance / s, "depth_range": depth_range, "height_above": height_above}
 
 
 def expected_error(sparse: np.ndarray, depth: np.ndarray) -> np.ndarray:
@@ -111,7 +111,7 @@ def expected_error(sparse: np.ndarray, depth: np.ndarray) -> np.ndarray:
         return np.stack([expected_error(s, d) for s, d in zip(sparse, depth)])
     f = support_features(sparse)
     r = f["distance"]
-    u = SPREAD_GAIN * r * f["spread"]
+    u = RANGE_GAIN * r * f["depth_range"]
     above = f["height_above"] > ABOVE_SPACINGS
     if above.any():
         floor = u[~above].max() if (~above).any() else 0.0

@@ -6,7 +6,7 @@ import pytest
 from scipy.stats import spearmanr
 
 from lipjax import uncertainty
-from lipjax.uncertainty import ABOVE_GAIN, SPREAD_GAIN, drop_uncertain, expected_error, support_features
+from lipjax.uncertainty import ABOVE_GAIN, RANGE_GAIN, drop_uncertain, expected_error, support_features
 
 
 def _grid_frame():
@@ -22,8 +22,8 @@ def test_value_by_hand_and_zero_on_measured_pixels():
     sparse, depth = _grid_frame()
     assert uncertainty.box_sample_spacing_px(sparse) == pytest.approx(7.0)
     u = expected_error(sparse, depth)
-    # (5, 5): nearest sample at sqrt(50) px = sqrt(50) / 7 spacings; the 29-px window sees both depths: spread 2 m
-    assert u[5, 5] == pytest.approx(SPREAD_GAIN * math.sqrt(50) / 7 * 2.0, rel=1e-5)
+    # (5, 5): nearest sample at sqrt(50) px = sqrt(50) / 7 spacings; the 29-px window sees both depths: range 2 m
+    assert u[5, 5] == pytest.approx(RANGE_GAIN * math.sqrt(50) / 7 * 2.0, rel=1e-5)
     assert (u[sparse > 0] == 0).all() and u.dtype == np.float32
 
 
@@ -96,7 +96,7 @@ def test_ranks_the_linear_fill_error_on_synthetic_test_frames():
         dense = linear_fill(sparse)
         scored = sample.valid & (sparse == 0)
         u, error = expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored]
-        # it ranks the error better than the distance to the samples alone (the spread term carries information:
+        # it ranks the error better than the distance to the samples alone (the depth-range term carries information:
         # measured 0.23-0.50 against 0.21-0.36 on these frames)
         distance = support_features(sparse)["distance"][scored]
         assert spearmanr(u, error)[0] > spearmanr(distance, error)[0] > 0
