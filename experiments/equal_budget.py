@@ -37,9 +37,9 @@ import pathlib
 import shutil
 import sys
 
-import numpy as np
 
 from experiments.configs.study import BRANCHES, METHODS, SCENES, TRUNKS, branch_config, test_split, trunk_config
+from experiments.study_report import write_report
 from lipjax.train.config import TrainConfig
 from lipjax.console import ArgumentParser, run_main
 from lipjax.data.protocols import get_protocol
@@ -295,9 +295,7 @@ def run_study(study: Study, progress: bool = True) -> None:
     for scene, trunk, seed, upto in plan(study):
         score_classical(study, scene)
         run_trunk(study, scene, trunk, seed, upto, progress)
-        from experiments.study_report import write_report
-
-        write_report(study)
+        write_report(study, missing(study))
 
 
 def _write_json(path: pathlib.Path, doc) -> None:
@@ -344,8 +342,6 @@ def main(argv=None) -> None:
                       None if args.tiny else WARM_STARTS)
     except ValueError as exc:
         p.error(str(exc))
-    from experiments.study_report import write_report
-
     if args.plan:
         left = missing(study)
         print("\n".join(f"{s} {t} seed {k} up to {n} images" + (" (done)" if _done(study, s, t, k, n) else "")
@@ -355,7 +351,7 @@ def main(argv=None) -> None:
     enable_compilation_cache()
     if not args.report:
         run_study(study, progress=not args.no_progress)
-    write_report(study, pathlib.Path(args.results))
+    write_report(study, missing(study), pathlib.Path(args.results))
 
 
 if __name__ == "__main__":

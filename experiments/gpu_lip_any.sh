@@ -20,14 +20,7 @@ RESERVE_S=${RESERVE_S:-60}
 LOG=$OUT/log.txt
 mkdir -p "$OUT"
 elapsed() { echo $(( $(date +%s) - T0 )); }
-if [ -n "${WHEELS:-}" ]; then
-  python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site \
-    "$WHEELS"/*.whl >> "$LOG" 2>&1 || { echo "installing $WHEELS failed" >> "$LOG"; exit 3; }
-  export PYTHONPATH=/tmp/site:$PWD
-fi
-export PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false JAX_COMPILATION_CACHE_DIR=/tmp/jaxcache
-python3 -c "import jax, flax, grain; print('jax', jax.__version__, 'flax', flax.__version__, jax.devices())" \
-  >> "$LOG" 2>&1 || { echo "import failed" >> "$LOG"; exit 4; }
+. "$(dirname "$0")/gpu_env.sh"
 TRAIN="python3 -m experiments.train --config lip_any --no-progress --set init_from=$INIT --set seed=$SEED
   --set data.clutter_prob=0.5 --set data.foliage_prob=0.5 --set loss=log_rmse --set data.num_workers=14"
 if [ -z "${STEPS:-}" ]; then

@@ -32,14 +32,7 @@ if [ -n "${TINY:-}" ]; then
 fi
 LOG=$OUT/log.txt
 mkdir -p "$OUT" "$ROOT"
-if [ -n "${WHEELS:-}" ]; then
-  python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site \
-    "$WHEELS"/*.whl >> "$LOG" 2>&1 || { echo "installing $WHEELS failed" >> "$LOG"; exit 3; }
-  export PYTHONPATH=/tmp/site:$PWD
-fi
-export PYTHONUNBUFFERED=1 XLA_PYTHON_CLIENT_PREALLOCATE=false JAX_COMPILATION_CACHE_DIR=/tmp/jaxcache
-python3 -c "import jax, flax, grain; print('jax', jax.__version__, 'flax', flax.__version__, jax.devices())" \
-  >> "$LOG" 2>&1 || { echo "import failed" >> "$LOG"; exit 4; }
+. "$(dirname "$0")/gpu_env.sh"
 LEFT=$(( BUDGET_S - ($(date +%s) - T0) - RESERVE_S ))
 echo "== the study for $LEFT s: $ARGS" >> "$LOG"
 timeout -s TERM "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" \

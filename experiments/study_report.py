@@ -196,13 +196,12 @@ def plot_iterations(path: pathlib.Path, per_k: dict, title: str) -> None:
     fig.savefig(path)
 
 
-def write_report(study, out: pathlib.Path | None = None) -> dict:
-    """Writes the report of `study` (an experiments.equal_budget.Study) into `out` (default: <root>/report)."""
-    from experiments.equal_budget import missing
-
+def write_report(study, scores_left: list[str], out: pathlib.Path | None = None) -> dict:
+    """Writes the report of `study` (an experiments.equal_budget.Study, whose `scores_left` are still to run) into
+    `out` (default: <root>/report)."""
     out = pathlib.Path(out) if out is not None else study.root / "report"
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict = {"details": {"scores_left": missing(study)}}
+    doc: dict = {"details": {"scores_left": scores_left}}
     for scene in SCENES:
         scores = load_scores(study.scores, scene)
         classical_path = study.scores_dir(scene) / "classical.json"

@@ -24,14 +24,13 @@ from collections.abc import Callable
 from typing import Any
 
 import cv2
-import jax
 import numpy as np
 
 from lipjax import model_io
 from lipjax.data.augment import DEFAULT_TRAINING
 from lipjax.data.hidden import HIDE, HIDE_SHARE
-from lipjax.train.folder import fitted_batch_size, folder_config
-from lipjax.train.run import KEEPS, run
+from lipjax.train.folder import fitted_to_folder, folder_config
+from lipjax.train.run import check_keep, run
 
 ADAPT_STEPS, ADAPT_BATCH_SIZE = 500, 8  # an adaptation's length and frames per step
 ADAPT_WARMUP_SHARE = 0.1  # of the steps, at most folder_config's warm-up
@@ -82,11 +81,9 @@ def adapt_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str |
 
     Returns the validation metrics (metres, on the hidden samples) of the exported model.
     """
-    from lipjax.data.sources import open_source
     from lipjax.shipped import DEFAULT_MODEL
 
-    if keep not in KEEPS:
-        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
+    check_keep(keep)
     init, hide = DEFAULT_MODEL if init is None else init, HIDE_SHARE if hide is None else hide
     data = {"root": os.fspath(root), **{k: v for k, v in data.items() if v is not None}}
     given = [k for k in ("train_sampler", "val_sampler") if k in data]
@@ -96,17 +93,11 @@ def adapt_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str |
     name = pathlib.Path(out).name
     config = adapt_config(model_io.load(init)[0], init, name=name, hide=hide, steps=steps or ADAPT_STEPS,
                           batch_size=batch_size or ADAPT_BATCH_SIZE, **data)
-    frames = len(open_source(config.data, "train").dataset)
     if log is not None:
         log(f"self-supervised from {init}: {hide:g} of each frame's samples hidden from its input (whole scan-line "
-            f"segments on LiDAR input), the loss at them alone; {frames} training frame(s)")
-    if frames < config.batch_size:
-        asked = config.batch_size
-        config = dataclasses.replace(config, batch_size=fitted_batch_size(asked, frames, jax.device_count()))
-        if log is not None:
-            log(f"batch size {config.batch_size}: the folder's {frames} training frame(s) fill no batch of {asked}; "
-                "add frames for larger batches")
-    return run(config, workdir or f"runs/adapt-{name}", export=out, progress=progress, validate_start=True, keep=keep)
+            "segments on LiDAR input), the loss at them alone")
+    return run(fitted_to_folder(config, log), workdir or f"runs/adapt-{name}", export=out, progress=progress,
+               validate_start=True, keep=keep)
 
 
 ADAPT_FRAME_STEPS = 50  # steps of one frame's adaptation on itself (`adapt_frame`)

@@ -76,6 +76,23 @@ def fitted_batch_size(batch_size: int, frames: int, devices: int = 1) -> int:
     return fitted
 
 
+def fitted_to_folder(config: TrainConfig, log=None) -> TrainConfig:
+    """`config` with a batch its folder's training frames fill (`fitted_batch_size`), said in one line to `log` (a
+    callable taking a line, or None) when it is smaller than asked."""
+    import jax
+
+    from lipjax.data.sources import open_source
+
+    frames, asked = len(open_source(config.data, "train").dataset), config.batch_size
+    if frames >= asked:
+        return config
+    config = dataclasses.replace(config, batch_size=fitted_batch_size(asked, frames, jax.device_count()))
+    if log is not None:
+        log(f"batch size {config.batch_size}: the folder's {frames} training frame(s) fill no batch of {asked}; "
+            "add frames for larger batches")
+    return config
+
+
 def own_input_validation(data: dict) -> dict:
     """DataConfig fields over FOLDER_DATA for a run on a folder's own sparse input (train_sampler "input[:N]") that
     names no val_sampler: validation draws the same input (the sensor the model is tuned to) where the validation

@@ -27,7 +27,7 @@ from lipjax.interfaces import MIXED_SCENES
 from lipjax.train.checkpoint import CheckpointManager
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
-from lipjax.train.folder import check_frames, default_init, fitted_batch_size, folder_config
+from lipjax.train.folder import check_frames, default_init, fitted_to_folder, folder_config
 from lipjax.train.folder import own_input_validation
 from lipjax.train.loop import check_same_run, data_streams, evaluate_params, export as export_model, train
 from lipjax.train.loop import validation_batches
@@ -116,6 +116,11 @@ def check_writable(folder: str | os.PathLike, what: str) -> None:
 KEEPS = ("best", "last")  # what `run` exports when the end validates worse than the start: the start, or the end
 
 
+def check_keep(keep: str) -> None:
+    if keep not in KEEPS:
+        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
+
+
 def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.PathLike | None = None,
         export_only: bool = False, average: int = 1, progress: bool = True, validate_start: bool = False,
         keep: str = "last") -> dict:
@@ -135,8 +140,7 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     workdir = pathlib.Path(workdir)
     if average < 1:
         raise ValueError(f"--average {average}: give a number of checkpoints >= 1")
-    if keep not in KEEPS:
-        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
+    check_keep(keep)
     if export is not None:
         check_writable(pathlib.Path(export).parent, "the model (--out / --export)")
     if config.data.source == "folder" and not export_only:
@@ -238,11 +242,8 @@ def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: s
 
     Returns the validation metrics (metres) of the exported model, as `run`.
     """
-    from lipjax.data.sources import open_source
-
     data = own_input_validation({"root": os.fspath(root), **{k: v for k, v in data.items() if v is not None}})
-    if keep not in KEEPS:
-        raise ValueError(f"keep={keep!r}: choose 'best' (the start when the end validates worse) or 'last'")
+    check_keep(keep)
     if init is None:
         init, scene, why = default_init(**data)
         if log is not None:
@@ -250,10 +251,5 @@ def fine_tune_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: s
     name = pathlib.Path(out).name
     config = folder_config(model_io.load(init)[0], init, name=name, **data)
     config = dataclasses.replace(config, **{k: v for k, v in (("g_steps", steps), ("batch_size", batch_size)) if v})
-    frames, asked = len(open_source(config.data, "train").dataset), config.batch_size
-    if frames < asked:
-        config = dataclasses.replace(config, batch_size=fitted_batch_size(asked, frames, jax.device_count()))
-        if log is not None:
-            log(f"batch size {config.batch_size}: the folder's {frames} training frame(s) fill no batch of {asked}; "
-                "add frames for larger batches")
+    config = fitted_to_folder(config, log)
     return run(config, workdir or f"runs/train-{name}", export=out, progress=progress, validate_start=True, keep=keep)
