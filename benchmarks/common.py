@@ -191,8 +191,8 @@ def ratios_to_linear(model, linear, sample, spec, images, cross_check: bool = CR
         return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
 
     completer, reference = get_completer(model, sparse=sparse), rmse(linear(sample.rgb, sparse))
-    mirror = None if cross_check else False  # the default path, or the model alone
-    return [rmse(complete_frame(completer, rgb, sparse, mirror=mirror, cross_check=cross_check)) / reference
+    flip = None if cross_check else False  # the default path, or the model alone
+    return [rmse(complete_frame(completer, rgb, sparse, flip=flip, cross_check=cross_check)) / reference
             for rgb in images]
 
 

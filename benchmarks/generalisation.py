@@ -53,7 +53,7 @@ def main(argv=None) -> None:
     ap.add_argument("--frames", type=int, default=8, help="test frames per setting")
     ap.add_argument("--json", default=None, help="write the per-frame ratios here")
     ap.add_argument("--no-cross-check", dest="cross_check", action="store_false",
-                    help="the model's estimate itself, without lipjax.crosscheck nor the mirror image on scan lines "
+                    help="the model's estimate itself, without lipjax.crosscheck nor the flipped frame on scan lines "
                          "(how model suites are compared)")
     ap.add_argument("--against", default=None, metavar="SHIPPED.json",
                     help="the shipped model's --json suite (same --frames, --no-cross-check): print the ship check")

@@ -1,8 +1,8 @@
 """Which host fill to start the learned prox from (z_0): linear or nearest, against the samples' spacing.
 
-The model's own estimate is scored (`cross_check=False`, `mirror=False`): the default path's check against the
-linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its mirror image on scan lines
-(lipjax.inference.mirrors) a second estimate.
+The model's own estimate is scored (`cross_check=False`, `flip=False`): the default path's check against the
+linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its flipped frame on scan lines
+(lipjax.inference.flips) a second estimate.
 
     python -m benchmarks.initial_fill [--model lip-any] [--frames 4]
 
@@ -59,7 +59,7 @@ def main(argv=None) -> None:
             spacings.append(sample_spacing_px(reproject_sparse(sparse, frame_size(base, sparse))))
             for k, completer in variants.items():
                 t = time.perf_counter()
-                pred = complete_frame(completer, sample.rgb, sparse, mirror=False, cross_check=False)
+                pred = complete_frame(completer, sample.rgb, sparse, flip=False, cross_check=False)
                 times[k].append(time.perf_counter() - t)
                 ratios[k].append(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)) / ref)
         gm = {k: float(np.exp(np.mean(np.log(r)))) for k, r in ratios.items()}

@@ -5,8 +5,8 @@ Run by hand (never a test):
     python -m benchmarks.prox_speed [--height 256] [--width 320] [--iterations 3] [--repeats 20]
                                     [--models lip-fast-indoor,...]
 
-Rows: the paper-style prox (lipjax.priors.network "small" and "paper" presets) and the shared-encoder prox
-(lipjax.priors.guided "fast"), each as a K-iteration LIP model started from the linear fill (as the shipped
+Rows: the paper-style prox (lipjax.priors.network "small" and "paper" presets) and the fast prox
+(lipjax.priors.fast "fast"), each as a K-iteration LIP model started from the linear fill (as the shipped
 indoor models), untrained weights (speed does not depend on the weights), plus any shipped/saved models named
 with --models. Columns:
   GFLOP       XLA's flop count of the compiled solver for one frame (batch 1), without the host fill;
@@ -30,7 +30,7 @@ import numpy as np
 from benchmarks.common import matmul_rate, median_ms
 from lipjax.inference import Completer, compiled_apply, load_model
 from lipjax.model import LIPConfig
-from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
+from lipjax.priors.fast import PRESETS as FAST_PRESETS
 from lipjax.priors.network import network_preset
 
 
@@ -71,7 +71,7 @@ def main(argv=None) -> None:
     rows = {
         f"paper-style G 'small', K={args.iterations}": network_preset("small"),
         f"paper-style G 'paper', K={args.iterations}": network_preset("paper"),
-        f"shared-encoder G 'fast', K={args.iterations}": GUIDED_PRESETS["fast"],
+        f"the fast prox G, K={args.iterations}": FAST_PRESETS["fast"],
     }
     completers = {name: Completer.random(LIPConfig(prior=prior, num_iterations=args.iterations,
                                                    initial_estimate="linear"))

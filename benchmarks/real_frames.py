@@ -4,7 +4,7 @@ and on the KITTI frames, the scores near the samples: at LiDAR points hidden fro
 Run by hand (never a test; the frames are research-use data read from ../shared/realdata, never copied):
 
     python -m benchmarks.real_frames [--model NAME] [--realdata ../shared/realdata] [--json out.json]
-                                     [--mirror | --no-mirror] [--sweep]
+                                     [--flip | --no-flip] [--sweep]
                                      [--plot docs/results/real_frames_working_res.png]
     python -m benchmarks.real_frames --hidden-only [--model NAME] [--json out.json]   # the KITTI checks alone
 
@@ -17,13 +17,13 @@ pixels. The reference is `linear` (Delaunay piecewise-linear, nearest outside th
 Columns: the default path (`lipjax complete` without flags: `get_completer(None, sparse)` picks the model and
 `complete_frame` its working size), the same with a uniform grey image (the RGB guidance's worth: grey / RGB),
 ip_basic and colorization. `--model` scores one model through the same path instead of the default choice;
-`--mirror` runs the path with mirror averaging on every input (`lipjax complete --mirror`; by default on scan lines
-only) for the model and its grey run, `--no-mirror` on none.
+`--flip` runs the path with flip averaging on every input (`lipjax complete --flip`; by default on scan lines
+only) for the model and its grey run, `--no-flip` on none.
 `--sweep` also runs the model at several target sample spacings (lipjax.resolution, with its pixel cap) and at the
 native size ("full"), and plots the geometric-mean ratio against the working resolution.
 
 Near the samples (issue 55: "never worse than linear"), on the 3 KITTI frames with their HDL-64 input, three checks
-of the default path (`lipjax.complete`, with `--model` and `--mirror` as above), `linear` and `ip_basic`, each as RMSE
+of the default path (`lipjax.complete`, with `--model` and `--flip` as above), `linear` and `ip_basic`, each as RMSE
 and MAE (m) and the default path's ratio to linear:
 
     dense ground truth   the whole input; scored on the unsampled valid ground-truth pixels (the table above)
@@ -122,7 +122,7 @@ def errors(pred: np.ndarray, sample: Sample, mask: np.ndarray) -> tuple[float, f
     return float(np.sqrt(np.mean(e ** 2))), float(np.mean(np.abs(e)))
 
 
-def hidden_checks(kitti: list[tuple[Sample, np.ndarray]], model, mirror) -> list[dict]:
+def hidden_checks(kitti: list[tuple[Sample, np.ndarray]], model, flip) -> list[dict]:
     """The checks near the samples (module docstring) on each (KITTI frame, its HDL-64 input): one row per frame
     and check, with (RMSE, MAE) of "default" and of each of HIDDEN_METHODS."""
     methods = [get_completer(m) for m in HIDDEN_METHODS]
@@ -138,7 +138,7 @@ def hidden_checks(kitti: list[tuple[Sample, np.ndarray]], model, mirror) -> list
             row = {"frame": sample.id, "check": check, "input_points": int((given > 0).sum()),
                    "scored_points": int(mask.sum()), "note": note, "model": completer.name,
                    "working_size": list(frame_size(completer, given)),
-                   "default": errors(complete(sample.rgb, given, model, mirror=mirror), sample, mask)}
+                   "default": errors(complete(sample.rgb, given, model, flip=flip), sample, mask)}
             for m in methods:
                 row[m.name] = errors(m(sample.rgb, given), sample, mask)
             rows.append(row)
@@ -181,8 +181,8 @@ def main(argv=None) -> None:
     ap.add_argument("--realdata", default=REALDATA)
     ap.add_argument("--json", default=None,
                     help="write the rows here (with --hidden-only: the rows of the checks near the samples)")
-    ap.add_argument("--mirror", action=argparse.BooleanOptionalAction,
-                    help="the path with (--mirror) or without (--no-mirror) mirror averaging on every input")
+    ap.add_argument("--flip", action=argparse.BooleanOptionalAction,
+                    help="the path with (--flip) or without (--no-flip) flip averaging on every input")
     ap.add_argument("--sweep", action="store_true", help="also sweep the working resolution")
     ap.add_argument("--plot", default=None, help="with --sweep: write the ratio-vs-resolution picture here")
     ap.add_argument("--classical", default="ip_basic,colorization", help="comma-separated classical methods")
@@ -193,7 +193,7 @@ def main(argv=None) -> None:
     if args.hidden_only:
         print("Near the samples: the KITTI frames with their HDL-64 input")
         hidden = hidden_checks([(s, KITTI_LIDAR(s, 0)) for s in load_kitti(os.path.join(root, "kitti"))],
-                               args.model, args.mirror)
+                               args.model, args.flip)
         hidden_table(hidden)
         _write_json(args.json, hidden)
         return
@@ -204,7 +204,7 @@ def main(argv=None) -> None:
         sweep_table(rows, args.plot)
     print("\nNear the samples: the KITTI frames with their HDL-64 input")
     hidden = hidden_checks([(s, sparse) for group, s, sparse, _ in inputs if group == "kitti-hdl64"],
-                           args.model, args.mirror)
+                           args.model, args.flip)
     hidden_table(hidden)
     for r in rows:  # the checks ride on their frame's HDL-64 row
         if r["group"] == "kitti-hdl64":
@@ -229,19 +229,19 @@ def frame_rows(inputs, args) -> list[dict]:
         grey = np.full_like(sample.rgb, GREY)
         ref = rmse(linear(sample.rgb, sparse), sample, sparse)
         t0 = time.perf_counter()
-        pred = complete_frame(completer, sample.rgb, sparse, mirror=args.mirror)
+        pred = complete_frame(completer, sample.rgb, sparse, flip=args.flip)
         ms = 1e3 * (time.perf_counter() - t0)
         row = {"group": group, "frame": sample.id, "input": input_name, "size": list(sample.shape),
                "model": completer.name, "working_size": list(frame_size(completer, sparse)),
                "linear_rmse_m": ref, "default": rmse(pred, sample, sparse) / ref,
-               "grey": rmse(complete_frame(completer, grey, sparse, mirror=args.mirror), sample, sparse) / ref,
+               "grey": rmse(complete_frame(completer, grey, sparse, flip=args.flip), sample, sparse) / ref,
                "ms": ms}
         for method in classical:
             row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
         if args.sweep:
             spacing, lines = sample_spacing_px(sparse), is_lidar_pattern(sparse)
             row["sweep"] = {str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(
-                sample.shape, spacing, t, lines), mirror=args.mirror), sample, sparse) / ref for t in SWEEP_TARGETS_PX}
+                sample.shape, spacing, t, lines), flip=args.flip), sample, sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
         print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "

@@ -10,8 +10,8 @@ Frames: synthetic test renders (the test split, never trained on) at 256x320 and
 352x1216 with the HDL-64 pattern (a KITTI-size street, ~19,000 samples). Each learned model runs
 through `lipjax.inference.complete_frame`, as `lipjax complete` does: at its working size (lipjax.resolution),
 host fill, solver and resizes included, on scattered samples the check against the linear fill
-(lipjax.crosscheck) and on scan lines the mirror image (lipjax.inference.mirrors); "unchecked:NAME" is the same
-without the check (`--no-cross-check`; the mirror image on scan lines stays). "default" is the model
+(lipjax.crosscheck) and on scan lines the flipped frame (lipjax.inference.flips); "unchecked:NAME" is the same
+without the check (`--no-cross-check`; the flipped frame on scan lines stays). "default" is the model
 `lipjax complete` picks for the frame.
 "onnx:NAME" (NAME a model or "default") is that model exported for the frame's size and sample count
 (lipjax.onnx_export: one graph, fill and resizes inside) and run under onnxruntime on the CPU with its default

@@ -1,8 +1,8 @@
 """Chooses the learned prox's working resolution on synthetic renders larger than the training frames.
 
-The model's own estimate is scored (`cross_check=False`, `mirror=False`): the default path's check against the
-linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its mirror image on scan lines
-(lipjax.inference.mirrors) a second estimate.
+The model's own estimate is scored (`cross_check=False`, `flip=False`): the default path's check against the
+linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its flipped frame on scan lines
+(lipjax.inference.flips) a second estimate.
 
     python -m benchmarks.working_resolution [--model lip-fast-indoor] [--frames 12] [--out runs/eval/working_res]
 
@@ -68,7 +68,7 @@ def run(model: str, frames: int) -> dict:
             for t, p in RULES:
                 size = working_size((h, w), spacing, t, p)
                 if size not in by_size:  # rules that give the same size share one run
-                    pred = complete_at(completer, sample.rgb, sparse, size, mirror=False, cross_check=False)
+                    pred = complete_at(completer, sample.rgb, sparse, size, flip=False, cross_check=False)
                     by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"

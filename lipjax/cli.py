@@ -4,13 +4,13 @@ fine-tuning and export. Depth is in metres; 0 means no depth.
     lipjax complete --rgb IMG --depth SPARSE [--depth-scale S] [--model NAME|PATH] [--iterations K] --out OUT
                     [--max-side N] [--ply FILE (--intrinsics fx fy cx cy | --intrinsics-file F)] [--threads N]
                     [--uncertainty FILE] [--max-uncertainty M] [--fill-all | --blank-unsupported]
-                    [--[no-]mirror] [--no-cross-check] [--explain: print each frame's plan, write nothing]
+                    [--[no-]flip] [--no-cross-check] [--explain: print each frame's plan, write nothing]
     lipjax complete --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out OUT ...   (the sweep projected first)
     lipjax project --rgb IMG --lidar SWEEP --calib FILE [--camera 2] --out SPARSE.npy|.png   (the sparse input only)
     lipjax evaluate [--model NAME|PATH ...] [--data synthetic-indoor|synthetic-outdoor|FOLDER] [--sampler SPEC]
     lipjax evaluate [--model NAME|PATH ...] --source NAME --root DIR [--raw-root DIR] [--split val] (as training reads)
     lipjax evaluate [--model NAME|PATH ...] --source synthetic [--kind indoor|outdoor] [--split val]
-    lipjax export [--model M] --height H --width W [--batch B] [--samples N] [--scattered] [--[no-]mirror] --out F
+    lipjax export [--model M] --height H --width W [--batch B] [--samples N] [--scattered] [--[no-]flip] --out F
     lipjax train --data FOLDER --out MODEL [--depth-scale S] [--steps N] [--keep best|last] [--self-supervised]
     lipjax data render --kind indoor|outdoor --split train --count N --out DIR [--workers W]
     lipjax models | lipjax --version
@@ -36,7 +36,7 @@ def _cmd_complete(args) -> int:
     if args.threads:
         utils.limit_cpu_threads(args.threads)
     frames = {k: getattr(args, k) for k in ("lidar", "calib", "camera", "depth_scale", "model", "iterations",
-                                            "max_side", "cross_check", "mirror")}  # what the plan of a frame needs
+                                            "max_side", "cross_check", "flip")}  # what the plan of a frame needs
     if args.explain:
         print(files.explain_files(args.rgb, args.depth, **frames).summary())
         return 0
@@ -77,7 +77,7 @@ def _cmd_export(args) -> int:
     platforms = tuple(p.strip() for p in args.platforms.split(",")) if args.platforms else None
     try:
         written = export(args.model, args.out, iterations=args.iterations, platforms=platforms, **{
-            k: getattr(args, k) for k in ("height", "width", "batch", "samples", "scattered", "mirror")})
+            k: getattr(args, k) for k in ("height", "width", "batch", "samples", "scattered", "flip")})
     except ImportError as exc:  # the optional flatbuffers / onnx packages
         raise console.UserError(str(exc)) from exc
     if not args.quiet:
@@ -157,7 +157,7 @@ def _add_complete_parser(sub) -> None:
     where = c.add_mutually_exclusive_group()  # neither: what the model or method returns, as lipjax.complete
     where.add_argument("--fill-all", action="store_true", help="depth at every pixel (0s a method leaves: nearest)")
     where.add_argument("--blank-unsupported", action="store_true", help="0 where no sample supports the depth")
-    c.add_argument("--mirror", action=_BOOL, help="learned models: average in the mirror image (default: scan lines)")
+    c.add_argument("--flip", action=_BOOL, help="learned models: average in the flipped frame (default: scan lines)")
     c.add_argument("--no-cross-check", dest="cross_check", action="store_false", help="no linear-fill check")
     out.add_argument("--explain", action="store_true", help="print each frame's plan; run and write nothing (above)")
     c.add_argument("--threads", type=console.positive_int, metavar="N", help="run on N CPU cores (default: every one)")
@@ -223,7 +223,7 @@ def _add_export_parser(sub) -> None:
     x.add_argument("--batch", type=console.positive_int, default=1)
     x.add_argument("--samples", type=console.positive_int, help=".onnx: samples per frame (sets the working size)")
     x.add_argument("--scattered", action="store_true", help=".onnx: scattered points, not LiDAR scan lines")
-    x.add_argument("--mirror", action=_BOOL, help=".onnx: as lipjax complete's, in the graph (default: scan lines)")
+    x.add_argument("--flip", action=_BOOL, help=".onnx: as lipjax complete's, in the graph (default: scan lines)")
     x.add_argument("--platforms", help=".stablehlo: comma-separated, e.g. cpu,cuda (default: this machine's)")
     x.add_argument("--out", required=True, metavar="FILE", help="FILE.onnx (onnxruntime) or FILE.stablehlo (jax)")
     x.add_argument("-q", "--quiet", action="store_true", help="no summary line")

@@ -87,8 +87,8 @@ values exactly, at any size. A hand-crafted method (--model ip_basic, linear, ..
 is written as the method returns it (IP-Basic, as published, replaces background returns seen through gaps in the
 foreground); run below full size (--max-side), its measured pixels are set back too.
 `--max-side N` overrides the working size: the longer side becomes at most N pixels. A learned model also runs the
-mirror image of LiDAR scan lines and averages the two (more accurate, twice the model's work, on the core the check
-leaves free); `--mirror` does so on every input, `--no-mirror` on none.
+flipped frame of LiDAR scan lines and averages the two (more accurate, twice the model's work, on the core the check
+leaves free); `--flip` does so on every input, `--no-flip` on none.
 With 100 scattered samples or more (not LiDAR scan lines) a learned model is checked against the linear fill on
 every sample, held out of its input in five folds, and leans on the fill on frames where it is the worse of the two;
 `--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).

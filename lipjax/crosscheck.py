@@ -29,7 +29,7 @@ kept samples (`held_out_size`, docs/decisions/0014-held-out-run-size.md): the mo
 trained to, in 0.8x the frame's working pixels (a second compiled program per frame size). Chosen on synthetic frames
 only, by rules fixed before measuring (docs/decisions/0013-cross-check-against-the-linear-fill.md,
 0015-cross-check-by-folds.md). Costs one more run of the model, FOLDS where the first fold goes against it (twice as
-many with `mirror`) and the linear fill at the held-out samples, plus a full one when it fires; `cross_check=False`
+many with `flip`) and the linear fill at the held-out samples, plus a full one when it fires; `cross_check=False`
 (lipjax.inference.CROSS_CHECK) skips it, and the ONNX graph does not hold it.
 XLA runs these models on about one of two CPU cores (480x640 with 200 points, training paused: the frame's and the
 first fold's estimates took 26 and 22 ms one after the other, 29 ms together in two threads), so the first fold runs

@@ -45,14 +45,14 @@ MIN_SCALE_CHANGE = 0.9
 # (set by hand)
 LARGE_FRAME_PIXELS = 2_000_000
 
-# ---- flip averaging (lipjax.inference.mirror_averaged)
+# ---- flip averaging (lipjax.inference.flip_averaged)
 # on LiDAR scan lines, where the check does not run and leaves the second core free: the suite 0.6350 -> 0.6323 x
 # linear, streets with HDL-64 0.404 -> 0.391, the 352x1216 street in two threads 37 -> 42 ms (0020); not on scattered
 # samples, where the check's held-out fold takes that core (480x640 with 200 points 36 -> 61 ms with both; fewer than
 # 100 samples: 0021)
 #   python -m benchmarks.generalisation --frames 8
 #   python -m benchmarks.kitti_like_gt --frames 24 --start 8
-MIRROR_SCAN_LINES = True
+FLIP_SCAN_LINES = True
 
 # ---- residual spreading after the resize back (lipjax.spread)
 # on: the suite without the check 0.708148 -> 0.706272, KITTI-like streets 1.114 -> 1.028 x linear (0018, 0019)

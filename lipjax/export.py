@@ -173,18 +173,18 @@ class ExportedFile:
 
 def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int = 1, iterations: int | None = None,
            platforms: Sequence[str] | None = None, samples: int | None = None, scattered: bool = False,
-           mirror: bool | None = None) -> ExportedFile | OnnxFile:
+           flip: bool | None = None) -> ExportedFile | OnnxFile:
     """Exports a learned model (anything lipjax.methods.get_completer takes; None: the default model) for inputs
     (batch, height, width) pixels into `out`, whose extension chooses the format (`export_format`). `platforms`
     applies to .stablehlo, `samples` (per frame) and `scattered` (points, not LiDAR scan lines), which set the
-    working size, and `mirror` (lipjax.complete's mirror averaging in the graph; None: on scan lines), to .onnx.
+    working size, and `flip` (lipjax.complete's flip averaging in the graph; None: on scan lines), to .onnx.
 
     Raises ValueError for an unknown extension, an option of the other format or a hand-crafted fill (nothing
     learned to export), ImportError without the flatbuffers (.stablehlo) or onnx (.onnx) package; all before the
     model loads."""
     onnx = export_format(out) == ".onnx"
     other_format, other_options = (".stablehlo", {"--platforms": platforms}) if onnx else \
-        (".onnx", {"--samples": samples, "--scattered": scattered or None, "--mirror": mirror or None})
+        (".onnx", {"--samples": samples, "--scattered": scattered or None, "--flip": flip or None})
     for flag, value in other_options.items():
         if value is not None:
             raise ValueError(f"{flag} applies to {other_format} exports only; drop it for {os.fspath(out)}")
@@ -195,7 +195,7 @@ def export(model, out: str | os.PathLike, *, height: int, width: int, batch: int
                          "shipped model (lipjax models) or a saved model path")
     if onnx:
         return export_onnx(completer, out, height=height, width=width, batch=batch, samples=samples,
-                           scan_lines=not scattered, mirror=mirror)
+                           scan_lines=not scattered, flip=flip)
     exported = export_completer(completer, batch, height, width, platforms=platforms)
     path = save_exported(exported, out)
     return ExportedFile(path, exported, completer.config.initial_estimate if len(exported.in_avals) == 3 else None)

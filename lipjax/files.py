@@ -19,8 +19,8 @@ post-processes (uncertainty, the support mask) and writes each completed frame, 
 compiled once per frame shape (jax.jit caches one executable per shape). On 100 KITTI-size frames (`python -m
 benchmarks.folder_speed --keep DIR`, lip-any at 132x455) on the 2-core machine with training paused, a folder ran
 at 1.06-1.18x the warm single-frame rate (3 runs; single frame 32-35 ms); one frame at a time it ran at 0.86-0.90x in
-the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Since the default path averages in the mirror
-image on scan lines (lipjax.inference.mirrors), each frame keeps both cores busy itself, and the folder ran at
+the same session (0.78-0.87 in an earlier one, median 0.86 of 7 runs). Since the default path averages in the flipped
+frame on scan lines (lipjax.inference.flips), each frame keeps both cores busy itself, and the folder ran at
 0.82-0.89x (3 runs; single frame 38-41 ms), 0.82-0.85x one frame at a time (2 runs, interleaved). Per frame a folder
 adds 17.5 ms of CPU that one frame does not pay: PNG decoding 8.8, PNG encoding 5.6, the support mask 3.1. Every
 output file is written under a temporary name beside it and renamed once whole (lipjax.utils.written_whole), so a
@@ -326,7 +326,7 @@ def model_threads(completer: Any) -> int:
 
 
 def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, iterations: int | None,
-         max_side: int | None, mirror: bool | None, cross_check: bool, progress: bool,
+         max_side: int | None, flip: bool | None, cross_check: bool, progress: bool,
          log: Callable[[str], None] | None, workers: int) -> None:
     """Reads (prefetched), completes and writes (`_Writer`) every job of the plan, in order: the first frame in
     this thread, then `model_threads` frames at a time in threads of their own, whose warnings are shown from this
@@ -337,7 +337,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
 
     completer = bar = None
     threads = 1  # frames completed at once (`model_threads`), known once the model is
-    complete = functools.partial(complete_frame, max_side=max_side, mirror=mirror, cross_check=cross_check)
+    complete = functools.partial(complete_frame, max_side=max_side, flip=flip, cross_check=cross_check)
     in_flight: collections.deque = collections.deque()  # (the frame's future, its job and inputs), in order
 
     def deliver(job, rgb, sparse, intrinsics, dense, held=()) -> None:  # in order: warnings shown, written, counted
@@ -386,7 +386,7 @@ def _run(plan: Plan, read: Callable[[Job], tuple], output: _Output, model: Any, 
 def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out: str | os.PathLike | None, *,
                    lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
                    depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
-                   max_side: int | None = None, mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
+                   max_side: int | None = None, flip: bool | None = None, cross_check: bool = CROSS_CHECK,
                    out_format: str | None = None,
                    color_range: tuple[float, float] | None = None, ply: str | os.PathLike | None = None,
                    intrinsics: IntrinsicsLike | str | os.PathLike | None = None,
@@ -402,8 +402,8 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
         `color_range` metres, by default fitted to the first frame), or a folder with `out_format`.
       model, iterations: anything lipjax.methods.get_completer takes; None: the default of the first frame.
       max_side: run frames downsized to this longer side, pixels (default: the working size of the samples).
-      mirror: average a learned model's estimate with that of the mirror-image frame (lipjax.inference.mirror_averaged:
-        more accurate, twice the model's work); None: on LiDAR scan lines (lipjax.inference.mirrors).
+      flip: average a learned model's estimate with that of the flipped frame (lipjax.inference.flip_averaged:
+        more accurate, twice the model's work); None: on LiDAR scan lines (lipjax.inference.flips).
       cross_check: check a learned model against the linear fill on held-out samples (lipjax.crosscheck).
       ply, intrinsics: also write a coloured point cloud (metres), with the RGB camera's intrinsics (pixels: an
         Intrinsics, (fx, fy, cx, cy), K, or a file lipjax.data.folder.read_intrinsics reads; a sweep's calibration
@@ -450,7 +450,7 @@ def complete_files(rgb: str | os.PathLike, depth: str | os.PathLike | None, out:
 
     output = _Output(plan.fmt, depth_scale or DEFAULT_PNG_OUT_SCALE, tuple(color_range) if color_range else None,
                      fill_all, blank_unsupported, max_uncertainty)
-    _run(plan, read, output, model, iterations, max_side, mirror, cross_check, progress, log, workers)
+    _run(plan, read, output, model, iterations, max_side, flip, cross_check, progress, log, workers)
     pixels = output.pixels or 1
     return Completed([j.out for j in plan.jobs], [j.ply for j in plan.jobs if j.ply], Path(out),
                      time.perf_counter() - start, output.unsupported / pixels,
@@ -494,7 +494,7 @@ class Explained:
 def explain_files(rgb: str | os.PathLike, depth: str | os.PathLike | None = None, *,
                   lidar: str | os.PathLike | None = None, calib: str | os.PathLike | None = None, camera: int = 2,
                   depth_scale: float | None = None, model: Any = None, iterations: int | None = None,
-                  max_side: int | None = None, mirror: bool | None = None,
+                  max_side: int | None = None, flip: bool | None = None,
                   cross_check: bool = CROSS_CHECK) -> Explained:
     """The plan (lipjax.inference.plan_frame) of every frame that `complete_files` completes with the same
     arguments: each frame read and checked and its plan made; no model runs and nothing is written (`lipjax
@@ -506,7 +506,7 @@ def explain_files(rgb: str | os.PathLike, depth: str | os.PathLike | None = None
         _, sparse = one_frame(frame_rgb, sparse)
         if completer is None:  # after the first frame is read, as `complete_files` loads it
             completer = get_completer(model, iterations)
-        frames.append((rgb_path, plan_frame(completer, sparse, max_side, mirror=mirror, cross_check=cross_check)))
+        frames.append((rgb_path, plan_frame(completer, sparse, max_side, flip=flip, cross_check=cross_check)))
     return Explained(frames)
 
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from lipjax import crosscheck, model_io
 from lipjax.defaults import (CROSS_CHECK, LARGE_FRAME_PIXELS, MAX_WORKING_PIXELS,  # noqa: F401  (read from here too)
-                             MIRROR_SCAN_LINES, SPREAD_RESIDUALS, TARGET_SPACING_PX)
+                             FLIP_SCAN_LINES, SPREAD_RESIDUALS, TARGET_SPACING_PX)
 from lipjax.inputs import InputError, check_inputs, is_lidar_pattern, quietly  # noqa: F401  (lipjax.InputError)
 from lipjax.interfaces import MIXED_SCENES, LearnedModel
 from lipjax.model import LIPConfig
@@ -142,10 +142,10 @@ def default_model() -> Completer:
     return Completer.random()
 
 
-# Threads that run the mirror image's estimate beside the frame's (`mirror_averaged`, on the CPU): a pool of its own,
+# Threads that run the flipped frame's estimate beside the frame's (`flip_averaged`, on the CPU): a pool of its own,
 # as a held-out fold running in lipjax.crosscheck's threads asks for one (its tasks wait on nothing, so a full pool
 # only queues them); one per fold and one for the frame.
-_MIRROR_BESIDE = ThreadPoolExecutor(max_workers=crosscheck.FOLDS + 1, thread_name_prefix="lipjax-mirror")
+_FLIP_BESIDE = ThreadPoolExecutor(max_workers=crosscheck.FOLDS + 1, thread_name_prefix="lipjax-flip")
 
 # The patterns of samples the default path tells apart (`sample_pattern`), each treated in its own way, and what
 # each is, in words (`FramePlan.describe`).
@@ -186,7 +186,7 @@ class FramePlan:
       max_side: the caller's cap on the longer side, pixels (--max-side), or None.
       fill: the initial estimate z_0 the model starts from at that size ("nearest", "linear", "box_fill", "sparse";
         LIPConfig.initial_fill of the pattern); None for an end-to-end network or a hand-crafted method.
-      mirror: average the model's estimate with the mirror image's (`mirror_averaged`).
+      flip: average the model's estimate with the flipped frame's (`flip_averaged`).
       spread: spread the samples' residuals over an estimate resized back to full size (lipjax.spread).
       cross_check: check the model against the linear fill on held-out samples (lipjax.crosscheck).
     """
@@ -199,7 +199,7 @@ class FramePlan:
     size: tuple[int, int]
     max_side: int | None
     fill: str | None
-    mirror: bool
+    flip: bool
     spread: bool
     cross_check: bool
 
@@ -239,7 +239,7 @@ class FramePlan:
                 f"{big_h}x{big_w}, {spacing:.1f} px apart",
                 f"working size: {h}x{w} ({scale}; {why_size})",
                 f"initial fill: {self.fill or 'none'}" + ("" if self.learned else " (the method is the fill)"),
-                f"flip averaging: {_on(self.mirror)}",
+                f"flip averaging: {_on(self.flip)}",
                 f"residual spreading: {spreading}",
                 f"cross-check against the linear fill: {_on(self.cross_check)}" + self._unchecked(),
                 "measured pixels: " + ("set back to their values" if self.set_back else "as the method returns them")]
@@ -297,13 +297,13 @@ def frame_size(completer, sparse_m: np.ndarray, max_side: int | None = None, *,
     return working_size(shape, spacing, capped=is_capped(int(np.count_nonzero(sparse_m > 0)), shape, lines))
 
 
-def mirrors(completer, scan_lines: bool, mirror: bool | None) -> bool:
-    """Whether the default path averages `completer`'s estimate of a frame with the mirror image's: `mirror` where
+def flips(completer, scan_lines: bool, flip: bool | None) -> bool:
+    """Whether the default path averages `completer`'s estimate of a frame with the flipped frame's: `flip` where
     it is given, else (None) for a learned model on LiDAR scan lines (`scan_lines`: lipjax.inputs.is_lidar_pattern
-    of the frame's samples; MIRROR_SCAN_LINES)."""
-    if mirror is not None:
-        return mirror
-    return MIRROR_SCAN_LINES and scan_lines and isinstance(completer, Completer)
+    of the frame's samples; FLIP_SCAN_LINES)."""
+    if flip is not None:
+        return flip
+    return FLIP_SCAN_LINES and scan_lines and isinstance(completer, Completer)
 
 
 def one_frame(rgb: np.ndarray, sparse_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -316,33 +316,33 @@ def one_frame(rgb: np.ndarray, sparse_m: np.ndarray) -> tuple[np.ndarray, np.nda
     return rgb[0], sparse[0]
 
 
-def plan_frame(completer, sparse_m: np.ndarray, max_side: int | None = None, *, mirror: bool | None = None,
+def plan_frame(completer, sparse_m: np.ndarray, max_side: int | None = None, *, flip: bool | None = None,
                cross_check: bool = CROSS_CHECK, spread: bool = SPREAD_RESIDUALS, size: tuple[int, int] | None = None,
                scan_lines: bool | None = None) -> FramePlan:
     """The `FramePlan` of `completer` on a frame with checked (H, W) samples `sparse_m` (metres; `one_frame`): the
     pattern asked once (`sample_pattern`; `scan_lines` when the caller knows it), and from it the working size
     (`frame_size`; `size` instead when given, `max_side` to cap it), the model's initial fill, flip averaging
-    (`mirrors`: `mirror`, None for the default), residual spreading (`spread`) and the cross-check (`cross_check`,
-    for a learned model on SCATTERED samples). InputError for `mirror` with a completer that is not learned."""
+    (`flips`: `flip`, None for the default), residual spreading (`spread`) and the cross-check (`cross_check`,
+    for a learned model on SCATTERED samples). InputError for `flip` with a completer that is not learned."""
     learned = isinstance(completer, Completer)
-    if mirror and not learned:
-        raise InputError(f"mirror averaging is for learned models; drop --mirror (mirror=True) for {completer.name}")
+    if flip and not learned:
+        raise InputError(f"flip averaging is for learned models; drop --flip (flip=True) for {completer.name}")
     pattern = sample_pattern(sparse_m, scan_lines)
     lines = pattern == SCAN_LINES
     return FramePlan(
         model=getattr(completer, "name", type(completer).__name__), learned=learned, shape=tuple(sparse_m.shape),
         samples=int(np.count_nonzero(sparse_m > 0)), pattern=pattern, max_side=max_side,
         size=tuple(size) if size is not None else frame_size(completer, sparse_m, max_side, scan_lines=lines),
-        fill=completer.config.initial_fill(lines) if learned else None, mirror=mirrors(completer, lines, mirror),
+        fill=completer.config.initial_fill(lines) if learned else None, flip=flips(completer, lines, flip),
         spread=spread, cross_check=cross_check and learned and pattern == SCATTERED)
 
 
 def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: int | None = None, *,
-                   mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
+                   flip: bool | None = None, cross_check: bool = CROSS_CHECK,
                    plan: FramePlan | None = None) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame: the default path (`lipjax.complete`, `lipjax complete`), stage by
     stage as its plan (`plan_frame`) says. `max_side` caps the longer side (pixels) instead of the working size,
-    `mirror` and `cross_check` as in `plan_frame`; or `plan`, made for this frame already (`complete_at`).
+    `flip` and `cross_check` as in `plan_frame`; or `plan`, made for this frame already (`complete_at`).
 
     The final x-update runs at full size: with rho -> 0 at the measured pixels (m = 1), x = (m y + rho z) / (m + rho)
     sets every measured pixel back to its measured value (the model's own last x-update, with its learned rho, keeps
@@ -354,7 +354,7 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     rgb, sparse_m = one_frame(rgb, sparse_m)
     # 2. the plan: the samples' pattern asked once, and every decision that follows from it
     if plan is None:
-        plan = plan_frame(completer, sparse_m, max_side, mirror=mirror, cross_check=cross_check)
+        plan = plan_frame(completer, sparse_m, max_side, flip=flip, cross_check=cross_check)
     # 3. the estimate from a set of samples at a size (`estimate_at`): the RGB and the samples to the working size,
     #    the initial fill, the network (flip-averaged), the resize back, the residuals spread
     estimate = functools.partial(estimate_at, completer, rgb, plan)
@@ -363,7 +363,8 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
         dense, _ = crosscheck.cross_checked(estimate, sparse_m, plan.size, scan_lines=plan.scan_lines)
     else:
         dense = estimate(sparse_m, plan.size)
-    # 5. the measured pixels set back: the final x-update with rho -> 0 where m = 1
+    # 5. the measured pixels set back: the final x-update with rho -> 0 where m = 1 (also under a sensor's parallax:
+    #    docs/decisions/0029-set-back-under-parallax.md)
     if plan.set_back:
         measured = sparse_m > 0
         dense[measured] = sparse_m[measured]
@@ -375,7 +376,7 @@ def estimate_at(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarra
     """z (H, W) float32 metres: `completer`'s estimate from the (H, W) samples `sparse_m` (the frame's, or those a
     cross-check fold keeps) run at `at` (h, w). Below full size the RGB is area-resized, the samples move onto the
     small grid (`reproject_sparse`), the model runs there (from its initial fill of the plan's pattern, computed on
-    the host; averaged with the mirror image's estimate with plan.mirror), its estimate is resized back (bilinear)
+    the host; averaged with the flipped frame's estimate with plan.flip), its estimate is resized back (bilinear)
     and, with plan.spread, the samples' residuals y - z are spread over it (`lipjax.spread`; scan lines get their
     own sigmas). Measured pixels are not set back here (`complete_frame` does it, after any cross-check).
     (Carrying the prox's correction over to a full-size linear fill, F * bilinear(z / f), was tried instead of
@@ -395,22 +396,22 @@ def estimate_at(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarra
 def model_run(completer, plan: FramePlan) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """(rgb, sparse) -> depth at their size, as the plan runs `completer`: a learned model told the frame's pattern
     (its input checks and its initial fill then take it rather than asking lipjax.inputs.is_lidar_pattern of the
-    resized map), `mirror_averaged` with plan.mirror; any other completer as it is."""
+    resized map), `flip_averaged` with plan.flip; any other completer as it is."""
     if not plan.learned:
         return completer
-    if plan.mirror:
-        return functools.partial(mirror_averaged, completer, scan_lines=plan.scan_lines)
+    if plan.flip:
+        return functools.partial(flip_averaged, completer, scan_lines=plan.scan_lines)
     return functools.partial(completer, scan_lines=plan.scan_lines)
 
 
 def complete_at(completer, rgb: np.ndarray, sparse_m: np.ndarray, size: tuple[int, int], *,
-                mirror: bool | None = None, cross_check: bool = CROSS_CHECK,
+                flip: bool | None = None, cross_check: bool = CROSS_CHECK,
                 spread: bool = SPREAD_RESIDUALS, scan_lines: bool | None = None) -> np.ndarray:
     """Dense (H, W) float32 metres for one frame, `completer` run at `size` (h, w) rather than at its working size:
-    `complete_frame` with the plan of `plan_frame(..., size=size)` (`mirror`, `cross_check`, `spread` and
+    `complete_frame` with the plan of `plan_frame(..., size=size)` (`flip`, `cross_check`, `spread` and
     `scan_lines` as there), for benchmarks that sweep the size or turn a stage off."""
     rgb, sparse_m = one_frame(rgb, sparse_m)  # before any resize could hide a size mismatch
-    plan = plan_frame(completer, sparse_m, mirror=mirror, cross_check=cross_check, spread=spread, size=size,
+    plan = plan_frame(completer, sparse_m, flip=flip, cross_check=cross_check, spread=spread, size=size,
                       scan_lines=scan_lines)
     return complete_frame(completer, rgb, sparse_m, plan=plan)
 
@@ -432,10 +433,10 @@ class AtWorkingSize:
         return complete_frame(self.completer, rgb, sparse_m)
 
 
-def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray,
+def flip_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray,
                     scan_lines: bool | None = None) -> np.ndarray:
     """(z(I, y) + flip(z(flip(I), flip(y)))) / 2 for one frame, rgb (h, w, 3) and sparse (h, w) metres: the model's
-    estimate averaged with its estimate of the mirror-image frame, flipped back (`scan_lines`: the frame's pattern,
+    estimate averaged with its estimate of the flipped frame, flipped back (`scan_lines`: the frame's pattern,
     as `Completer.__call__` takes it). On the CPU the two run side by side in two threads, as XLA runs a model on
     about one core (lip-any on the 352x1216 street at 132x455, training paused: 32 ms in two threads, 52 ms as one
     batch of two, 26 ms for one frame); elsewhere as one batch of two."""
@@ -443,6 +444,6 @@ def mirror_averaged(completer: Completer, rgb: np.ndarray, sparse_m: np.ndarray,
     if jax.default_backend() != "cpu":
         both = run(np.stack([rgb, rgb[:, ::-1]]), np.stack([sparse_m, sparse_m[:, ::-1]]))
         return 0.5 * (both[0] + both[1][:, ::-1])
-    mirrored = _MIRROR_BESIDE.submit(quietly, run, rgb[:, ::-1], sparse_m[:, ::-1])  # checked as the frame is
+    flipped = _FLIP_BESIDE.submit(quietly, run, rgb[:, ::-1], sparse_m[:, ::-1])  # checked as the frame is
     z = run(rgb, sparse_m)
-    return 0.5 * (z + mirrored.result()[:, ::-1])
+    return 0.5 * (z + flipped.result()[:, ::-1])

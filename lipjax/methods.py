@@ -103,15 +103,15 @@ def available_methods(scene: str) -> list[str]:
 
 def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, fill_all: bool = False,
              blank_unsupported: bool = False, max_uncertainty: float | None = None, return_uncertainty: bool = False,
-             mirror: bool | None = None, cross_check: bool = CROSS_CHECK):
+             flip: bool | None = None, cross_check: bool = CROSS_CHECK):
     """Completes depth: RGB uint8 (H,W,3) or (B,H,W,3), sparse depth in metres (0 = missing) -> dense metres.
 
     `model`: anything `get_completer` takes; by default the shipped default model. Each frame runs through the
     default path (`lipjax.inference.complete_frame`, as its `plan_frame` says): a learned model at the working size
     of the samples' spacing, every measured pixel set back; a hand-crafted method (CLASSICAL) returns exactly what
-    it returns itself, as published (IP-Basic leaves 0 out of reach of its dilations). `mirror` also runs a learned
-    model on the mirror-image frame and averages (more accurate, twice the model's work; None: on LiDAR scan lines,
-    lipjax.inference.mirrors); `cross_check` checks it against the linear fill on held-out samples
+    it returns itself, as published (IP-Basic leaves 0 out of reach of its dilations). `flip` also runs a learned
+    model on the flipped frame and averages (more accurate, twice the model's work; None: on LiDAR scan lines,
+    lipjax.inference.flips); `cross_check` checks it against the linear fill on held-out samples
     (lipjax.crosscheck; CROSS_CHECK).
     By default the depth is the model's or method's, at every pixel it gives depth, as `lipjax complete` writes it.
     `fill_all`: depth at every pixel, the 0s left filled with the nearest pixel's depth
@@ -126,10 +126,10 @@ def complete(rgb: np.ndarray, sparse: np.ndarray, model: Any = None, *, fill_all
     completer = get_completer(model)
     rgb, sparse = np.asarray(rgb), np.asarray(sparse)
     if sparse.ndim == 3:
-        dense = np.stack([complete_frame(completer, c, y, mirror=mirror, cross_check=cross_check)
+        dense = np.stack([complete_frame(completer, c, y, flip=flip, cross_check=cross_check)
                           for c, y in zip(rgb, sparse)])
     else:
-        dense = complete_frame(completer, rgb, sparse, mirror=mirror, cross_check=cross_check)
+        dense = complete_frame(completer, rgb, sparse, flip=flip, cross_check=cross_check)
     if fill_all:
         dense = fill_holes(dense)
     u = expected_error(sparse, dense) if max_uncertainty is not None or return_uncertainty else None

@@ -24,7 +24,7 @@ import numpy as np
 from lipjax.inputs import OUTDOOR_MEDIAN_M
 from lipjax.interfaces import MODEL_TYPES, PRIOR_TYPES, model_type_name
 from lipjax.model import LIPConfig
-import lipjax.priors.guided  # noqa: F401  (registers the prior types model files name)
+import lipjax.priors.fast  # noqa: F401  (registers the prior types model files name)
 import lipjax.priors.network  # noqa: F401
 import lipjax.priors.wavelet  # noqa: F401
 from lipjax.shipped import DEFAULT_MODELS, WEIGHTS_DIR, available
@@ -62,6 +62,11 @@ def config_to_dict(config) -> dict:
     return {"model_type": "lip", "prior_type": prior_type, "prior": dataclasses.asdict(config.prior), **fields}
 
 
+# Prior types under the names that files written by earlier versions give them: the fast prox (lipjax.priors.fast)
+# was "guided" until 2026-12-06.
+RENAMED_PRIOR_TYPES = {"guided": "fast"}
+
+
 def config_from_dict(d: dict):
     d = dict(d)
     model_type = d.pop("model_type", "lip")
@@ -71,6 +76,7 @@ def config_from_dict(d: dict):
     if model_type != "lip":
         return types[model_type](**_tuples(d))
     kind = d.pop("prior_type")
+    kind = RENAMED_PRIOR_TYPES.get(kind, kind)
     if kind not in PRIOR_TYPES:
         raise ValueError(f"unknown prior type {kind!r} in model file; known: {sorted(PRIOR_TYPES)}")
     return LIPConfig(prior=PRIOR_TYPES[kind](**_tuples(d.pop("prior"))), **d)

@@ -37,18 +37,18 @@ than the one lipjax trains with, see that module):
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
      (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured
-     pixels set back to their measured values. For LiDAR scan lines (and with `mirror=True`, `lipjax export
-     --mirror`, for scattered samples) the frames and their mirror images run as one batch of 2B, and each frame's
+     pixels set back to their measured values. For LiDAR scan lines (and with `flip=True`, `lipjax export
+     --flip`, for scattered samples) the frames and their flipped frames run as one batch of 2B, and each frame's
      two estimates are averaged after flipping the second back, as `lipjax.complete` does on scan lines (flip
-     averaging, docs/decisions/0020-flip-averaging-on-scan-lines.md; `--no-mirror` leaves it out, at half the model's
+     averaging, docs/decisions/0020-flip-averaging-on-scan-lines.md; `--no-flip` leaves it out, at half the model's
      work).
 At h, w = H, W the resizes drop out, as in complete_at; the measured pixels are set back at any size. The check
 of the model against the linear fill on held-out samples (lipjax.crosscheck; scattered samples only) is not in the
 graph (it needs the Delaunay fill): the graph is `lipjax.complete(..., cross_check=False)`. No input
 checks run inside the graph (check with `lipjax.inputs.check_inputs` where lipjax is installed); a frame without
 samples gives zeros.
-Speed (benchmarks/speed.py, 2-core machine): a KITTI frame with its mirror image took 104 ms under onnxruntime
-against 42 ms for the same computation through lipjax.complete (83 against 37 ms without the mirror image, in an
+Speed (benchmarks/speed.py, 2-core machine): a KITTI frame with its flipped frame took 104 ms under onnxruntime
+against 42 ms for the same computation through lipjax.complete (83 against 37 ms without the flipped frame, in an
 earlier run); XLA fuses the element-wise operations that onnxruntime runs one pass each.
 """
 from __future__ import annotations
@@ -65,7 +65,7 @@ import jax.numpy as jnp
 from lipjax import jaxpr_to_onnx
 from lipjax.defaults import SPREAD_RESIDUALS
 from lipjax.fill import jump_flood_nearest
-from lipjax.inference import Completer, mirrors
+from lipjax.inference import Completer, flips
 from lipjax.model import LIPConfig
 from lipjax.resample import reproject_nearest, resize_area_uint8, resize_bilinear
 from lipjax.resolution import dense_from, is_capped, working_size
@@ -115,10 +115,10 @@ def samples_interval(height: int, width: int, samples: int, scan_lines: bool = T
 
 
 def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple[int, int], *,
-                    mirror: bool | None = None, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
+                    flip: bool | None = None, spread: bool = SPREAD_RESIDUALS, scan_lines: bool = True):
     """The jax function (rgb uint8 (B, H, W, 3), sparse float32 (B, H, W) m) -> depth (B, H, W) m that the ONNX
-    graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `mirror`:
-    average with the mirror-image frame as lipjax.complete does (None: on scan lines, lipjax.inference.mirrors);
+    graph is made of (the module docstring's steps 1-4); jit it to run the same computation in JAX. `flip`:
+    average with the flipped frame as lipjax.complete does (None: on scan lines, lipjax.inference.flips);
     `spread`: spread the samples' residuals after the resize back, as it does (lipjax.defaults.SPREAD_RESIDUALS),
     with the sigmas of LiDAR scan lines or (`scan_lines=False`) of scattered samples
     (lipjax.spread.spread_sigmas_px)."""
@@ -127,7 +127,7 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
     unknown = set(config.host_input_names) - {"z0"}
     if unknown:
         raise ValueError(f"{completer.name} needs host inputs {sorted(unknown)} that have no in-graph version")
-    resized, mirror = tuple(working) != tuple(frame), mirrors(completer, scan_lines, mirror)
+    resized, flip = tuple(working) != tuple(frame), flips(completer, scan_lines, flip)
 
     def model(rgb, sparse):
         extra = {name: jump_flood_nearest(sparse) for name in config.host_input_names}
@@ -136,10 +136,10 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
     def run(rgb, sparse):
         small_rgb, small = (resize_area_uint8(rgb, working) / 255.0, reproject_nearest(sparse, working)) if resized \
             else (rgb, sparse)
-        if mirror:  # lipjax.inference.mirror_averaged, the batch and its mirror images in one call
-            flip = functools.partial(jnp.flip, axis=2)
-            both = model(jnp.concatenate([small_rgb, flip(small_rgb)]), jnp.concatenate([small, flip(small)]))
-            depth = 0.5 * (both[:len(small)] + flip(both[len(small):]))
+        if flip:  # lipjax.inference.flip_averaged, the batch and its flipped frames in one call
+            turn = functools.partial(jnp.flip, axis=2)
+            both = model(jnp.concatenate([small_rgb, turn(small_rgb)]), jnp.concatenate([small, turn(small)]))
+            depth = 0.5 * (both[:len(small)] + turn(both[len(small):]))
         else:
             depth = model(small_rgb, small)
         if resized:
@@ -170,14 +170,14 @@ def nearest_twin(completer: Completer) -> Completer:
 class OnnxFile:
     """What `export_onnx` wrote: the file, the input shape (B, H, W), the working size, the sample counts for which
     that is lipjax.complete's working size, and the model's own initial fill when the graph's nearest fill replaced
-    it (else None); whether the graph averages with the mirror image."""
+    it (else None); whether the graph averages with the flipped frame."""
 
     path: pathlib.Path
     shape: tuple[int, int, int]
     working: tuple[int, int]
     samples: tuple[int, int]
     replaced_fill: str | None
-    mirror: bool = False
+    flip: bool = False
 
     def summary(self) -> str:
         """The lines the export command prints: file and signature, the working size, the fill."""
@@ -189,9 +189,9 @@ class OnnxFile:
         if self.replaced_fill:
             lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
                          "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
-        if self.mirror:
-            lines.append("mirror averaging in the graph (--no-mirror: without, at half the work): equal to "
-                         "lipjax.complete(..., mirror=True, cross_check=False)")
+        if self.flip:
+            lines.append("flip averaging in the graph (--no-flip: without, at half the work): equal to "
+                         "lipjax.complete(..., flip=True, cross_check=False)")
         return "\n".join(lines)
 
 
@@ -204,10 +204,10 @@ def need_onnx() -> None:
 
 
 def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, width: int, batch: int = 1,
-                samples: int | None = None, scan_lines: bool = True, mirror: bool | None = None) -> OnnxFile:
+                samples: int | None = None, scan_lines: bool = True, flip: bool | None = None) -> OnnxFile:
     """Writes the ONNX graph of `completer` for (batch, height, width) frames of `samples` samples each (default
-    `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`; `mirror` as
-    lipjax.complete's (None: on scan lines, lipjax.inference.mirrors). ImportError without the onnx package."""
+    `default_samples`), in LiDAR scan lines or (`scan_lines=False`) scattered, to `out`; `flip` as
+    lipjax.complete's (None: on scan lines, lipjax.inference.flips). ImportError without the onnx package."""
     need_onnx()
     import onnx
 
@@ -215,7 +215,7 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
         if int(value) < 1:
             raise ValueError(f"{name} must be >= 1, got {value}")
     samples = default_samples(height, width) if samples is None else samples
-    mirror = mirrors(completer, scan_lines, mirror)
+    flip = flips(completer, scan_lines, flip)
     working = export_working_size(height, width, samples, scan_lines)
     interval = samples_interval(height, width, samples, scan_lines)
     replaced = _host_fill(completer.config)
@@ -223,12 +223,12 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
                 "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
                 "working_size_samples": f"{interval[0]}-{interval[1]}" + ("" if scan_lines else " scattered"),
                 "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else ""),
-                "mirror_averaged": str(bool(mirror)).lower()}
+                "flip_averaged": str(bool(flip)).lower()}
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]
-    graph = inference_graph(completer, (height, width), working, mirror=mirror, scan_lines=scan_lines)
+    graph = inference_graph(completer, (height, width), working, flip=flip, scan_lines=scan_lines)
     model = jaxpr_to_onnx.convert(graph, specs, INPUT_NAMES, OUTPUT_NAMES, metadata, doc=__doc__.split("\n")[0])
     path = pathlib.Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     onnx.save(model, os.fspath(path))
-    return OnnxFile(path, (batch, height, width), working, interval, replaced, mirror)
+    return OnnxFile(path, (batch, height, width), working, interval, replaced, flip)

@@ -1,8 +1,8 @@
 """Where the default model loses to a linear fill, per frame: at depth edges, at colour-only edges, or on flat ground.
 
-The model's own estimate is scored (`cross_check=False`, `mirror=False`): the default path's check against the
-linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its mirror image on scan lines
-(lipjax.inference.mirrors) a second estimate.
+The model's own estimate is scored (`cross_check=False`, `flip=False`): the default path's check against the
+linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its flipped frame on scan lines
+(lipjax.inference.flips) a second estimate.
 
 Run by hand (never a test; the shared frames are read from ../shared/realdata, never copied):
 
@@ -52,8 +52,8 @@ def frame_row(name: str, input_name: str, rgb, depth, valid, sparse, linear,
     completer = get_completer(model, sparse=sparse)
     keep = valid & (sparse <= 0) & (depth > 0)
     e_lin = np.where(keep, linear(rgb, sparse) - depth, 0.0)
-    def error(image):  # the model's own estimate: neither the check nor the mirror image
-        return np.where(keep, complete_frame(completer, image, sparse, mirror=False, cross_check=False) - depth, 0.0)
+    def error(image):  # the model's own estimate: neither the check nor the flipped frame
+        return np.where(keep, complete_frame(completer, image, sparse, flip=False, cross_check=False) - depth, 0.0)
 
     e_rgb, e_grey = error(rgb), error(np.full_like(rgb, GREY))
     classes = pixel_classes(rgb, depth, valid)

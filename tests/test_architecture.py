@@ -236,7 +236,7 @@ def test_the_default_paths_numbers_are_assigned_in_lipjax_defaults_only():
     numbers = assigned(PACKAGE / "defaults.py")
     found = [f"{path.relative_to(ROOT)}: {name}" for path in sorted(PACKAGE.rglob("*.py"))
              if path != PACKAGE / "defaults.py" for name in sorted(assigned(path) & numbers)]
-    assert {"TARGET_SPACING_PX", "CROSS_CHECK", "MIRROR_SCAN_LINES", "SPREAD_RESIDUALS", "FOLDS"} <= numbers
+    assert {"TARGET_SPACING_PX", "CROSS_CHECK", "FLIP_SCAN_LINES", "SPREAD_RESIDUALS", "FOLDS"} <= numbers
     assert found == [], "\n".join(found)
 
 

@@ -88,19 +88,19 @@ def test_npy_in_npy_out_metres_equals_library(model, frame, tmp_path):
     np.testing.assert_allclose(out, complete_frame(model[1], frame["rgb_array"], frame["sparse_array"]), rtol=1e-6)
 
 
-def test_mirror_flags_equal_the_library_with_mirror_on_and_off(model, frame, tmp_path):
-    """--mirror and --no-mirror are mirror=True and False (the default, None, mirrors scan lines only)."""
+def test_flip_flags_equal_the_library_with_flip_on_and_off(model, frame, tmp_path):
+    """--flip and --no-flip are flip=True and False (the default, None, flips scan lines only)."""
     rgb, sparse = frame["rgb_array"], frame["sparse_array"]
-    assert _complete(model, frame, tmp_path / "on.npy", "--mirror") == 0
-    assert _complete(model, frame, tmp_path / "off.npy", "--no-mirror") == 0
+    assert _complete(model, frame, tmp_path / "on.npy", "--flip") == 0
+    assert _complete(model, frame, tmp_path / "off.npy", "--no-flip") == 0
     on, off = np.load(tmp_path / "on.npy"), np.load(tmp_path / "off.npy")
-    np.testing.assert_allclose(on, complete_frame(model[1], rgb, sparse, mirror=True), rtol=1e-6)
-    np.testing.assert_allclose(off, complete_frame(model[1], rgb, sparse, mirror=False), rtol=1e-6)
+    np.testing.assert_allclose(on, complete_frame(model[1], rgb, sparse, flip=True), rtol=1e-6)
+    np.testing.assert_allclose(off, complete_frame(model[1], rgb, sparse, flip=False), rtol=1e-6)
     assert np.abs(on - off).max() > 1e-3
     no_flag = (["complete", "--rgb", "a.png", "--out", "b.npy"], ["export", "--height", "8", "--width", "8",
                                                                    "--out", "m.onnx"])
     for command in no_flag:
-        assert cli.build_parser().parse_args(command).mirror is None  # no flag: the library's default decides
+        assert cli.build_parser().parse_args(command).flip is None  # no flag: the library's default decides
 
 
 def test_color_png_and_ply_outputs(model, frame, tmp_path):
@@ -452,7 +452,7 @@ def test_export_command_writes_an_onnx_graph_with_the_fill_inside(model, tmp_pat
     ort = pytest.importorskip("onnxruntime")
     out = tmp_path / "m.onnx"
     rc = cli.main(["export", "--model", model[0], "--height", str(H), "--width", str(W), "--scattered", "--out",
-                   str(out)])  # _frame's samples are scattered points: no mirror image, as lipjax.complete there
+                   str(out)])  # _frame's samples are scattered points: no flipped frame, as lipjax.complete there
     assert rc == 0 and f"wrote {out}" in capsys.readouterr().err
     rgb, sparse = _frame()
     got, = ort.InferenceSession(str(out), providers=["CPUExecutionProvider"]).run(

@@ -201,9 +201,9 @@ def test_the_held_out_run_resizes_to_its_own_working_size(monkeypatch):
     np.testing.assert_array_equal(x[sparse > 0], sparse[sparse > 0])
 
 
-@pytest.mark.parametrize("mirror", [False, True])
-def test_a_frame_that_warns_warns_once_from_the_same_line(mirror):
-    """The held-out runs' checks (and the mirror image's, each in a thread of its own) are quiet without touching the
+@pytest.mark.parametrize("flip", [False, True])
+def test_a_frame_that_warns_warns_once_from_the_same_line(flip):
+    """The held-out runs' checks (and the flipped frame's, each in a thread of its own) are quiet without touching the
     warning filters (whose every change makes Python forget what it has shown): three frames from one line warn
     once, as a folder of frames should."""
     depth = np.full((48, 64), 12.0, np.float32)  # beyond the untrained indoor model's 10 m range
@@ -213,7 +213,7 @@ def test_a_frame_that_warns_warns_once_from_the_same_line(mirror):
     with warnings.catch_warnings(record=True) as shown:
         warnings.simplefilter("default")
         for _ in range(3):
-            complete_at(model, rgb, sparse, depth.shape, mirror=mirror)
+            complete_at(model, rgb, sparse, depth.shape, flip=flip)
     assert len(shown) == 1 and "10 m range" in str(shown[0].message), [str(w.message) for w in shown]
 
 

@@ -183,50 +183,50 @@ def test_auto_initial_estimate_is_nearest_on_scan_lines_and_linear_on_scattered_
     assert not np.array_equal(nearest_fill(lines), linear_fill(lines))  # the two fills differ on this input
 
 
-def test_mirror_averaging_is_flip_equivariant_keeps_measurements_and_changes_the_estimate(monkeypatch):
-    """mirror_averaged(I, y) = (z(I, y) + flip(z(flip I, flip y))) / 2 is exactly flip-equivariant, which one call
-    of a network is not; the default path (complete_at, lipjax.complete) uses it on request (mirror=True; by
+def test_flip_averaging_is_flip_equivariant_keeps_measurements_and_changes_the_estimate(monkeypatch):
+    """flip_averaged(I, y) = (z(I, y) + flip(z(flip I, flip y))) / 2 is exactly flip-equivariant, which one call
+    of a network is not; the default path (complete_at, lipjax.complete) uses it on request (flip=True; by
     default on scan lines only) at full and at working size."""
-    from lipjax.inference import complete_at, mirror_averaged
+    from lipjax.inference import complete_at, flip_averaged
 
     completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
     rng = np.random.default_rng(5)
     rgb = rng.integers(0, 256, (40, 56, 3), dtype=np.uint8)
     sparse = np.where(rng.random((40, 56)) < 0.05, rng.uniform(1, 8, (40, 56)), 0).astype(np.float32)
-    averaged = mirror_averaged(completer, rgb, sparse)
-    mirrored = mirror_averaged(completer, rgb[:, ::-1].copy(), sparse[:, ::-1].copy())
-    np.testing.assert_array_equal(mirrored[:, ::-1], averaged)  # on the CPU: the same two calls, in two threads
+    averaged = flip_averaged(completer, rgb, sparse)
+    flipped = flip_averaged(completer, rgb[:, ::-1].copy(), sparse[:, ::-1].copy())
+    np.testing.assert_array_equal(flipped[:, ::-1], averaged)  # on the CPU: the same two calls, in two threads
     once = completer(rgb, sparse)
-    once_mirrored = completer(rgb[:, ::-1].copy(), sparse[:, ::-1].copy())
-    assert np.abs(once_mirrored[:, ::-1] - once).max() > 1e-3  # the network alone is not flip-equivariant
-    np.testing.assert_array_equal(averaged, 0.5 * (once + once_mirrored[:, ::-1]))
+    once_flipped = completer(rgb[:, ::-1].copy(), sparse[:, ::-1].copy())
+    assert np.abs(once_flipped[:, ::-1] - once).max() > 1e-3  # the network alone is not flip-equivariant
+    np.testing.assert_array_equal(averaged, 0.5 * (once + once_flipped[:, ::-1]))
     with monkeypatch.context() as patch:  # elsewhere one batch of two: XLA's batched convolutions round differently
         patch.setattr(inference.jax, "default_backend", lambda: "gpu")
-        batched = mirror_averaged(completer, rgb, sparse)
+        batched = flip_averaged(completer, rgb, sparse)
     np.testing.assert_allclose(batched, averaged, rtol=0, atol=1e-3)  # measured 2e-4 m
     for size in ((40, 56), (20, 28)):
-        got = complete_at(completer, rgb, sparse, size, mirror=True)
+        got = complete_at(completer, rgb, sparse, size, flip=True)
         assert np.abs(got - complete_at(completer, rgb, sparse, size)).max() > 1e-3  # off on scattered
     for size in ((40, 56), (20, 28)):  # at any size the measured pixels are set back (the model's x keeps them ~)
-        for mirror in (False, True):
-            got = complete_at(completer, rgb, sparse, size, mirror=mirror)
+        for flip in (False, True):
+            got = complete_at(completer, rgb, sparse, size, flip=flip)
             np.testing.assert_array_equal(got[sparse > 0], sparse[sparse > 0])
     assert np.abs(completer(rgb, sparse)[sparse > 0] - sparse[sparse > 0]).max() > 1e-3
     unmeasured = sparse == 0  # the check against the linear fill would blend this random model with the fill
-    got = complete_at(completer, rgb, sparse, (40, 56), mirror=True, cross_check=False)
+    got = complete_at(completer, rgb, sparse, (40, 56), flip=True, cross_check=False)
     np.testing.assert_allclose(got[unmeasured], averaged[unmeasured], rtol=0, atol=1e-6)
-    np.testing.assert_allclose(lipjax.complete(rgb, sparse, model=completer, mirror=True),
-                               inference.complete_frame(completer, rgb, sparse, mirror=True), rtol=0, atol=1e-6)
-    with pytest.raises(lipjax.InputError, match="mirror averaging is for learned models; drop --mirror"):
-        lipjax.complete(rgb, sparse, model="linear", mirror=True)
+    np.testing.assert_allclose(lipjax.complete(rgb, sparse, model=completer, flip=True),
+                               inference.complete_frame(completer, rgb, sparse, flip=True), rtol=0, atol=1e-6)
+    with pytest.raises(lipjax.InputError, match="flip averaging is for learned models; drop --flip"):
+        lipjax.complete(rgb, sparse, model="linear", flip=True)
 
 
 @pytest.mark.filterwarnings("ignore:samples in LiDAR scan lines")  # a tiny model trained on neither
-def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
-    """mirror=None (the default of complete_at, lipjax.complete): averaged with the mirror image on LiDAR scan lines,
+def test_by_default_the_flip_image_is_averaged_in_on_scan_lines_only():
+    """flip=None (the default of complete_at, lipjax.complete): averaged with the flipped frame on LiDAR scan lines,
     where the check does not run (docs/decisions/0020), and not on scattered samples; True and False force it either
-    way; a classical fill is never mirrored by default."""
-    from lipjax.inference import complete_at, is_lidar_pattern, mirrors
+    way; a classical fill is never flipped by default."""
+    from lipjax.inference import complete_at, is_lidar_pattern, flips
 
     completer = perturbed(lipjax.Completer(CONFIG, CONFIG.init(jax.random.key(0)), "tiny"), seed=2)
     rng = np.random.default_rng(8)
@@ -236,22 +236,22 @@ def test_by_default_the_mirror_image_is_averaged_in_on_scan_lines_only():
     scattered = np.where(rng.random((40, 56)) < 0.05, rng.uniform(1, 8, (40, 56)), 0).astype(np.float32)
     assert is_lidar_pattern(lines) and not is_lidar_pattern(scattered)
     for size in ((40, 56), (20, 28)):
-        def run(sparse, mirror=None):
-            return complete_at(completer, rgb, sparse, size, mirror=mirror, cross_check=False)
+        def run(sparse, flip=None):
+            return complete_at(completer, rgb, sparse, size, flip=flip, cross_check=False)
 
         np.testing.assert_array_equal(run(lines), run(lines, True))
         assert np.abs(run(lines) - run(lines, False)).max() > 1e-3
         np.testing.assert_array_equal(run(scattered), run(scattered, False))
         assert np.abs(run(scattered) - run(scattered, True)).max() > 1e-3
     # a caller that already asked the pattern (complete_frame) is believed: at full size (nothing spread) scan_lines
-    # only decides the mirror image
+    # only decides the flipped frame
     np.testing.assert_array_equal(complete_at(completer, rgb, scattered, (40, 56), cross_check=False, scan_lines=True),
-                                  complete_at(completer, rgb, scattered, (40, 56), cross_check=False, mirror=True))
+                                  complete_at(completer, rgb, scattered, (40, 56), cross_check=False, flip=True))
     np.testing.assert_array_equal(complete_at(completer, rgb, lines, (40, 56), cross_check=False, scan_lines=False),
-                                  complete_at(completer, rgb, lines, (40, 56), cross_check=False, mirror=False))
+                                  complete_at(completer, rgb, lines, (40, 56), cross_check=False, flip=False))
     np.testing.assert_array_equal(lipjax.complete(rgb, lines, model=completer),
-                                  lipjax.complete(rgb, lines, model=completer, mirror=True))
-    assert not mirrors(methods.get_completer("linear"), True, None) and mirrors(completer, True, None)
+                                  lipjax.complete(rgb, lines, model=completer, flip=True))
+    assert not flips(methods.get_completer("linear"), True, None) and flips(completer, True, None)
     np.testing.assert_array_equal(lipjax.complete(rgb, lines, model="linear"), linear_fill(lines))
 
 
@@ -288,7 +288,7 @@ def test_below_full_size_the_samples_residuals_are_spread_over_the_resized_estim
     z = cv2.resize(np.asarray(small, np.float32), (56, 40), interpolation=cv2.INTER_LINEAR)
     expected = spread_on_host(z, lines, (20, 28), scan_lines=True)
     expected[lines > 0] = lines[lines > 0]
-    got = complete_at(completer, rgb, lines, (20, 28), mirror=False)  # one run: the spread alone
+    got = complete_at(completer, rgb, lines, (20, 28), flip=False)  # one run: the spread alone
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-5)
     assert np.abs(spread_on_host(z, lines, (20, 28)) - expected)[lines == 0].max() > 1e-3
 
@@ -311,7 +311,7 @@ def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
     model = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), initial_estimate="auto"))
     (_, scan), (_, points) = street_and_room
     plan = inference.plan_frame(model, scan)
-    assert (plan.pattern, plan.scan_lines, plan.mirror, plan.cross_check, plan.fill) == (
+    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.fill) == (
         "scan lines", True, True, False, "nearest")
     assert plan.size == (132, 455) and plan.spread and plan.set_back and plan.samples == np.count_nonzero(scan)
     lines = plan.describe()
@@ -320,26 +320,26 @@ def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
     assert lines[2] == ("working size: 132x455 (0.38x of 352x1216; the rule: samples about 16 px apart, at most "
                         "60,000 pixels for scan lines)")
     plan = inference.plan_frame(model, points)
-    assert (plan.pattern, plan.scan_lines, plan.mirror, plan.cross_check, plan.fill, plan.size) == (
+    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.fill, plan.size) == (
         "scattered", False, False, True, "linear", (196, 261))
     lines = plan.describe()
     assert lines[1] == "pattern: scattered (100 or more, not in scan lines): 200 samples on 480x640, 39.2 px apart"
     assert "cross-check against the linear fill: on" in lines and "flip averaging: off" in lines
     # the switches and the caller's size; a hand-crafted method: at full size, as it returns, never checked
-    plan = inference.plan_frame(model, points, 160, mirror=True, cross_check=False)
-    assert (plan.size, plan.mirror, plan.cross_check) == ((120, 160), True, False)
+    plan = inference.plan_frame(model, points, 160, flip=True, cross_check=False)
+    assert (plan.size, plan.flip, plan.cross_check) == ((120, 160), True, False)
     assert "cross-check against the linear fill: off (turned off)" in plan.describe()
     plan = inference.plan_frame(methods.get_completer("linear"), scan)
-    assert (plan.learned, plan.size, plan.fill, plan.mirror, plan.cross_check, plan.set_back) == (
+    assert (plan.learned, plan.size, plan.fill, plan.flip, plan.cross_check, plan.set_back) == (
         False, (352, 1216), None, False, False, False)
-    with pytest.raises(lipjax.InputError, match="mirror averaging is for learned models"):
-        inference.plan_frame(methods.get_completer("linear"), scan, mirror=True)
+    with pytest.raises(lipjax.InputError, match="flip averaging is for learned models"):
+        inference.plan_frame(methods.get_completer("linear"), scan, flip=True)
 
 
 @pytest.mark.filterwarnings("ignore:sparse depth beyond", "ignore:samples in LiDAR")  # an indoor model on a street
 def test_the_default_path_asks_the_samples_pattern_once_per_frame(street_and_room, monkeypatch):
     """Issue 53: the pattern is asked of the full-size frame once (plan_frame) and passed down: the model's input
-    checks and its "auto" fill on the working-size map, the mirror image and the held-out folds take it."""
+    checks and its "auto" fill on the working-size map, the flipped frame and the held-out folds take it."""
     import cv2
 
     from lipjax import crosscheck, inputs, model as model_module

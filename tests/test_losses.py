@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from lipjax.model import LIPConfig
-from lipjax.priors.guided import sample_scale
+from lipjax.priors.fast import sample_scale
 from lipjax.priors.network import network_preset
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator

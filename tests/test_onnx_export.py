@@ -13,7 +13,7 @@ from lipjax import jaxpr_to_onnx
 from lipjax.inputs import is_lidar_pattern
 from lipjax.model import LIPConfig
 from lipjax.onnx_export import (export_onnx, export_working_size, inference_graph, nearest_twin, samples_interval)
-from lipjax.priors.guided import PRESETS
+from lipjax.priors.fast import PRESETS
 from lipjax.resolution import DENSE, MAX_WORKING_PIXELS, working_size
 
 from helpers import perturbed
@@ -89,34 +89,34 @@ def test_the_working_size_is_fixed_from_the_sample_count_for_an_interval_of_coun
 
 @pytest.fixture(scope="module")
 def auto_model():
-    """A tiny shared-encoder LIP model (as the shipped ones) with random, non-zero weights and the "auto" fill."""
+    """A tiny fast-prox LIP model (as the shipped ones) with random, non-zero weights and the "auto" fill."""
     config = LIPConfig(prior=PRESETS["tiny"], num_iterations=2, initial_estimate="auto", output="z")
     c = lipjax.Completer(config, lipjax.Completer.random(config, seed=1).params, "tiny-auto",
                          {"train_sampler": "uniform:10|lidar:hdl64"})  # no input warning for either pattern
     return perturbed(c)
 
 
-@pytest.mark.parametrize("mirror", [None, False, True])
-def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path, mirror):
+@pytest.mark.parametrize("flip", [None, False, True])
+def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill(auto_model, tmp_path, flip):
     """128x160 with 10 points runs at 64x80 (area resize, reprojection, bilinear back): scattered points, so
     lipjax.complete fills linearly and the graph equals the model's nearest twin, not the model itself; with and
-    without mirror averaging, and by default (None) without it, as complete on scattered points."""
+    without flip averaging, and by default (None) without it, as complete on scattered points."""
     h, w = 128, 160
     written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, scan_lines=False,
-                          mirror=mirror)
-    assert written.working == (64, 80) and written.replaced_fill == "auto" and written.mirror == bool(mirror)
+                          flip=flip)
+    assert written.working == (64, 80) and written.replaced_fill == "auto" and written.flip == bool(flip)
     assert "instead of the model's 'auto'" in written.summary() and "64x80" in written.summary()
     rng = np.random.default_rng(3)
     rgb = rng.integers(0, 256, (1, h, w, 3), dtype=np.uint8)
     sparse = np.zeros((1, h, w), np.float32)
     sparse.reshape(-1)[rng.choice(h * w, 10, replace=False)] = rng.uniform(1, 8, 10)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    graph = inference_graph(auto_model, (h, w), (64, 80), mirror=mirror, scan_lines=False)
+    graph = inference_graph(auto_model, (h, w), (64, 80), flip=flip, scan_lines=False)
     in_jax = np.asarray(jax.jit(graph)(rgb, sparse))
     np.testing.assert_allclose(got, in_jax, rtol=1e-5, atol=1e-5)
-    expected = lipjax.complete(rgb[0], sparse[0], model=nearest_twin(auto_model), mirror=mirror)
+    expected = lipjax.complete(rgb[0], sparse[0], model=nearest_twin(auto_model), flip=flip)
     np.testing.assert_allclose(got[0], expected, rtol=1e-5, atol=1e-4)
-    linear = lipjax.complete(rgb[0], sparse[0], model=auto_model, mirror=mirror)
+    linear = lipjax.complete(rgb[0], sparse[0], model=auto_model, flip=flip)
     assert np.abs(got[0] - linear).max() > 0.01  # the Delaunay fill differs: that is the documented gap
     measured = sparse[0] > 0
     np.testing.assert_array_equal(got[0][measured], sparse[0][measured])
@@ -124,9 +124,9 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
 
 def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_model, tmp_path):
     """A 48x64 frame runs at full size (no resize in the graph); on scan lines "auto" is the nearest fill, so the
-    exported batch of two equals lipjax.complete frame by frame (both without the mirror image: the fill alone)."""
+    exported batch of two equals lipjax.complete frame by frame (both without the flipped frame: the fill alone)."""
     b, h, w = 2, 48, 64
-    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b, mirror=False)
+    written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b, flip=False)
     assert written.working == (h, w) and written.shape == (b, h, w)
     rng = np.random.default_rng(4)
     rgb = rng.integers(0, 256, (b, h, w, 3), dtype=np.uint8)
@@ -134,14 +134,14 @@ def test_scan_lines_at_full_size_equal_complete_with_the_models_own_fill(auto_mo
     sparse[:, 1::3] = np.where(rng.random((b, 16, w)) < 0.7, rng.uniform(2, 9, (b, 16, w)), 0)
     assert all(is_lidar_pattern(s) for s in sparse)
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
-    expected = np.stack([lipjax.complete(c, s, model=auto_model, mirror=False) for c, s in zip(rgb, sparse)])
+    expected = np.stack([lipjax.complete(c, s, model=auto_model, flip=False) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
 
 
 def test_the_graph_spreads_scan_lines_with_their_own_sigmas_as_complete_does(auto_model):
     """A 48x64 scan at a 24x32 working size: the jax graph (scan_lines=True) equals complete_at, whose spread uses
     the scan-line sigmas (lipjax.spread.SCAN_LINE_SIGMAS_WORKING_PX) for this input; scattered sigmas differ (all
-    three without the mirror image, so that only the sigmas can tell them apart)."""
+    three without the flipped frame, so that only the sigmas can tell them apart)."""
     from lipjax.inference import complete_at
 
     h, w = 48, 64
@@ -150,14 +150,14 @@ def test_the_graph_spreads_scan_lines_with_their_own_sigmas_as_complete_does(aut
     sparse = np.zeros((1, h, w), np.float32)
     sparse[:, 1::4] = np.where(rng.random((1, 12, w)) < 0.8, rng.uniform(2, 9, (1, 12, w)), 0)
     assert is_lidar_pattern(sparse[0])
-    host = complete_at(auto_model, rgb[0], sparse[0], (24, 32), mirror=False)
-    lines, scattered = (np.asarray(jax.jit(inference_graph(auto_model, (h, w), (24, 32), mirror=False,
+    host = complete_at(auto_model, rgb[0], sparse[0], (24, 32), flip=False)
+    lines, scattered = (np.asarray(jax.jit(inference_graph(auto_model, (h, w), (24, 32), flip=False,
                                                            scan_lines=s))(rgb, sparse)) for s in (True, False))
     np.testing.assert_allclose(lines[0], host, rtol=1e-5, atol=1e-4)
     assert np.abs(scattered[0] - host).max() > 1e-3
 
 
-@pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}, {"mirror": True}])
+@pytest.mark.parametrize("option", [{"samples": 100}, {"scattered": True}, {"flip": True}])
 def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_path):
     from lipjax.export import export
 
@@ -166,13 +166,13 @@ def test_an_onnx_option_on_a_stablehlo_export_is_a_one_line_error(option, tmp_pa
         export("linear", tmp_path / "m.stablehlo", height=8, width=8, **option)
 
 
-def test_a_scan_line_export_averages_with_the_mirror_image_as_complete_does(auto_model, tmp_path):
-    """export_onnx on LiDAR scan lines holds the frame and its mirror image in one batch (lax.rev as ONNX Slice with
-    step -1), by default as with mirror=True, and equals lipjax.complete's default path there, which averages with the
-    flipped frame on scan lines (docs/decisions/0020); mirror=False (--no-mirror) leaves it out, as complete does."""
+def test_a_scan_line_export_averages_with_the_flip_image_as_complete_does(auto_model, tmp_path):
+    """export_onnx on LiDAR scan lines holds the frame and its flipped frame in one batch (lax.rev as ONNX Slice with
+    step -1), by default as with flip=True, and equals lipjax.complete's default path there, which averages with the
+    flipped frame on scan lines (docs/decisions/0020); flip=False (--no-flip) leaves it out, as complete does."""
     b, h, w = 2, 48, 64
     written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, batch=b)
-    plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b, mirror=False)
+    plain = export_onnx(auto_model, tmp_path / "plain.onnx", height=h, width=w, batch=b, flip=False)
     rng = np.random.default_rng(6)
     rgb = rng.integers(0, 256, (b, h, w, 3), dtype=np.uint8)
     sparse = np.zeros((b, h, w), np.float32)
@@ -181,14 +181,14 @@ def test_a_scan_line_export_averages_with_the_mirror_image_as_complete_does(auto
     got, = _run_onnx(str(written.path), rgb=rgb, sparse=sparse)
     expected = np.stack([lipjax.complete(c, s, model=auto_model) for c, s in zip(rgb, sparse)])
     np.testing.assert_allclose(got, expected, rtol=1e-5, atol=1e-4)
-    np.testing.assert_array_equal(expected, [lipjax.complete(c, s, model=auto_model, mirror=True)
+    np.testing.assert_array_equal(expected, [lipjax.complete(c, s, model=auto_model, flip=True)
                                              for c, s in zip(rgb, sparse)])
     without, = _run_onnx(str(plain.path), rgb=rgb, sparse=sparse)
-    np.testing.assert_allclose(without, [lipjax.complete(c, s, model=auto_model, mirror=False)
+    np.testing.assert_allclose(without, [lipjax.complete(c, s, model=auto_model, flip=False)
                                          for c, s in zip(rgb, sparse)], rtol=1e-5, atol=1e-4)
     assert np.abs(got - without).max() > 1e-3
     import onnx
 
-    assert {p.key: p.value for p in onnx.load(str(written.path)).metadata_props}["mirror_averaged"] == "true"
-    assert {p.key: p.value for p in onnx.load(str(plain.path)).metadata_props}["mirror_averaged"] == "false"
-    assert "mirror averaging in the graph" in written.summary() and "mirror averaging" not in plain.summary()
+    assert {p.key: p.value for p in onnx.load(str(written.path)).metadata_props}["flip_averaged"] == "true"
+    assert {p.key: p.value for p in onnx.load(str(plain.path)).metadata_props}["flip_averaged"] == "false"
+    assert "flip averaging in the graph" in written.summary() and "flip averaging" not in plain.summary()

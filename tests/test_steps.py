@@ -7,7 +7,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.model import LIPConfig
-from lipjax.priors.guided import sample_scale
+from lipjax.priors.fast import sample_scale
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.losses import LOG_RMSE_EPS, depth_loss, inverse_depth_loss

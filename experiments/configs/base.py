@@ -12,7 +12,7 @@ import dataclasses
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
-from lipjax.priors.guided import PRESETS as GUIDED_PRESETS
+from lipjax.priors.fast import PRESETS as FAST_PRESETS
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
 
@@ -92,8 +92,8 @@ def lip_model(max_depth_m: float, initial_estimate: str, output: str = "x",
 
 
 def fast_model(max_depth_m: float, initial_estimate: str) -> LIPConfig:
-    """The shared-encoder prox (lipjax.priors.guided "fast"), read out from the last prox (always positive)."""
-    prior = dataclasses.replace(GUIDED_PRESETS["fast"], max_depth_m=max_depth_m)
+    """The fast prox (lipjax.priors.fast "fast"), read out from the last prox (always positive)."""
+    prior = dataclasses.replace(FAST_PRESETS["fast"], max_depth_m=max_depth_m)
     return LIPConfig(prior=prior, num_iterations=3, initial_estimate=initial_estimate, output="z")
 
 
@@ -110,7 +110,7 @@ OUTDOOR = TrainConfig(
     batch_size=8, g_steps=900, learning_rate=5e-4, loss="l1", eval_every=200, checkpoint_every=50,
     inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
 )
-# Rooms and streets: the shared-encoder prox (it never sees a metric depth) from the "auto" fill (nearest on scan
+# Rooms and streets: the fast prox (it never sees a metric depth) from the "auto" fill (nearest on scan
 # lines, linear elsewhere: benchmarks/initial_fill.py), each frame's error in units of its own sample scale. No
 # schedule: its config (fast.py, lip_any) sets it.
 MIXED = TrainConfig(

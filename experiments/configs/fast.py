@@ -1,4 +1,4 @@
-"""The shipped default models: the fast prox (shared-encoder; lipjax.priors.guided "fast") on pre-rendered scenes, its
+"""The shipped default models: the fast prox (lipjax.priors.fast "fast") on pre-rendered scenes, its
 LIP+AD, and lip-any for rooms and streets; each one `dataclasses.replace` of its scene base (base.py).
 
 The prox has a third of the paper-style G's FLOPs per frame and trains ~2.7x faster here, so it trains longer for

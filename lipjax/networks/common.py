@@ -10,12 +10,12 @@ import jax
 import jax.numpy as jnp
 
 from lipjax.interfaces import LearnedModel, parameter_count
-from lipjax.priors.guided import sample_scale
+from lipjax.priors.fast import sample_scale
 
 # The depth unit u of a network's input and output (`depth_unit`): the network sees sparse / u and predicts depth / u.
 #   "max_depth": u = max_depth_m, one constant per model (the shipped baselines');
 #   "metres":    u = 1 m, Ma et al.'s raw depth input, so samples are as strong as in the papers' inputs;
-#   "samples":   u = the frame's own sample scale (the geometric mean of its samples, as the shared-encoder prox):
+#   "samples":   u = the frame's own sample scale (the geometric mean of its samples, as the fast prox):
 #                the network never needs a frame's absolute depth, which per-image normalisation (GroupNorm) erases.
 DEPTH_SCALES = ("max_depth", "metres", "samples")
 

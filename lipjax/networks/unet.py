@@ -8,7 +8,7 @@ import jax.numpy as jnp
 
 from lipjax.interfaces import SCENE_MAX_DEPTH_M, register_model_type
 from lipjax.networks.common import NetworkModel, check_depth_scale, check_max_depth, group_norm
-from lipjax.priors.guided import depth_to_space
+from lipjax.priors.fast import depth_to_space
 
 
 class _DoubleConv(nn.Module):

@@ -14,7 +14,7 @@ A prior is a hashable frozen dataclass (a static jit argument; lipjax.model.LIPC
                              guidance image; z: (B, H, W) float32 metres
 
 (lipjax.priors.network.NetworkPrior, lipjax.priors.wavelet.WaveletPrior). A prior whose guidance is encoded once per
-frame implements `SharedEncoderPrior` below instead (lipjax.priors.guided.GuidedPrior).
+frame implements `SharedEncoderPrior` below instead (lipjax.priors.fast.FastPrior).
 """
 from __future__ import annotations
 

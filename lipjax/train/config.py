@@ -107,7 +107,7 @@ class TrainConfig:
 
     def __post_init__(self):
         # "max_depth": errors / the prior's max depth (one constant per model); "samples": errors / each frame's
-        # own sample scale s (geometric mean of its sparse depths, lipjax.priors.guided.sample_scale), so rooms
+        # own sample scale s (geometric mean of its sparse depths, lipjax.priors.fast.sample_scale), so rooms
         # at 3 m and streets at 20 m weigh alike when one model trains on both.
         if self.loss_scale not in LOSS_SCALES:
             raise ValueError(f"loss_scale must be one of {LOSS_SCALES}, got {self.loss_scale!r}")

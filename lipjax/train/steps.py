@@ -15,7 +15,7 @@ import jax
 import jax.numpy as jnp
 import optax
 
-from lipjax.priors.guided import sample_scale
+from lipjax.priors.fast import sample_scale
 from lipjax.train.losses import discriminator_loss, generator_adversarial_loss, supervised_loss
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import TrainState, make_optimizers

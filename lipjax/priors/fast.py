@@ -234,10 +234,10 @@ def sample_scale(y: jax.Array, weights: jax.Array) -> jax.Array:
     return jnp.where(count > 0, jnp.exp(log_mean), 1.0)
 
 
-@register_prior_type("guided")
+@register_prior_type("fast")
 @dataclasses.dataclass(frozen=True)
-class GuidedPrior(SharedEncoderPrior):
-    """The shared-encoder prox as a `SharedEncoderPrior`: `encode` once per frame, then `apply` per iteration.
+class FastPrior(SharedEncoderPrior):
+    """The fast prox as a `SharedEncoderPrior`: `encode` once per frame, then `apply` per iteration.
 
     encoder_widths / branch_widths: channels at 1/2, 1/4 and 1/8 resolution.
     max_depth_m: the depth range of the scenes it is trained for (metres). The network never sees it (its input
@@ -285,9 +285,9 @@ class GuidedPrior(SharedEncoderPrior):
         return v_pos * jnp.exp(jnp.clip(residual, -RESIDUAL_CLIP, RESIDUAL_CLIP))
 
 
-PRESETS: dict[str, GuidedPrior] = {
+PRESETS: dict[str, FastPrior] = {
     # 5.9 GFLOP per 256x320 frame at K = 3 (benchmarks/prox_speed.py), against 18 for the paper-style "small".
-    "fast": GuidedPrior(),
+    "fast": FastPrior(),
     # For tests only.
-    "tiny": GuidedPrior(encoder_widths=(4, 8, 8), branch_widths=(4, 8, 8)),
+    "tiny": FastPrior(encoder_widths=(4, 8, 8), branch_widths=(4, 8, 8)),
 }

@@ -1,4 +1,4 @@
-"""The shared-encoder prox (lipjax.priors.guided): identity at init, scale equivariance, encoder run once."""
+"""The fast prox (lipjax.priors.fast): identity at init, scale equivariance, encoder run once."""
 import dataclasses
 
 import flax.linen as nn
@@ -9,7 +9,7 @@ import pytest
 
 from lipjax import model as lip_model
 from lipjax import model_io
-from lipjax.priors.guided import (PRESETS, DepthBranch, GuidanceEncoder, GuidedPrior, depth_to_space, sample_scale,
+from lipjax.priors.fast import (PRESETS, DepthBranch, GuidanceEncoder, FastPrior, depth_to_space, sample_scale,
                                   space_to_depth)
 
 TINY = PRESETS["tiny"]
@@ -110,7 +110,7 @@ def test_the_upsampling_convolution_and_its_gradient_are_those_of_upsample_then_
     convolution, and its gradient in both arguments matches finite differences."""
     from jax.test_util import check_grads
 
-    from lipjax.priors.guided import _conv, _upsampled_conv
+    from lipjax.priors.fast import _conv, _upsampled_conv
 
     rng = np.random.default_rng(3)
     low = jnp.asarray(rng.normal(size=(2, 5, 7, 3)), jnp.float32)
@@ -129,7 +129,7 @@ def test_the_upsampling_convolution_and_its_gradient_are_those_of_upsample_then_
 
 
 @dataclasses.dataclass(frozen=True)
-class _ReferencePrior(GuidedPrior):
+class _ReferencePrior(FastPrior):
     def _encoder(self):
         return _ReferenceEncoder(tuple(self.encoder_widths))
 
@@ -222,7 +222,7 @@ def test_encoder_is_shared_and_runs_once_per_frame():
     assert total - in_loop == n_enc  # the encoder runs once, outside the loop
 
 
-def test_guided_model_survives_a_model_file(tmp_path):
+def test_fast_prox_model_survives_a_model_file(tmp_path):
     config = _model()
     params = _scramble(config.init(jax.random.key(0)))
     model_io.save(tmp_path / "m", config, params)
@@ -235,8 +235,16 @@ def test_guided_model_survives_a_model_file(tmp_path):
     np.testing.assert_array_equal(a, b)
 
 
+def test_a_model_file_naming_the_fast_prox_guided_as_before_loads_as_the_fast_prox():
+    """Files written before the fast prox's type was "fast" name it "guided" (model_io.RENAMED_PRIOR_TYPES)."""
+    config = _model()
+    old = model_io.config_to_dict(config) | {"prior_type": "guided"}
+    assert model_io.config_to_dict(config)["prior_type"] == "fast"
+    assert model_io.config_from_dict(old) == config
+
+
 def test_bad_widths_are_clear_errors():
     with pytest.raises(ValueError, match="3 widths"):
-        GuidedPrior(encoder_widths=(8, 8))
+        FastPrior(encoder_widths=(8, 8))
     with pytest.raises(ValueError, match="must agree"):
         dataclasses.replace(TINY, branch_widths=(4, 16, 8))
