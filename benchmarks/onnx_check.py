@@ -13,7 +13,7 @@ exported at 352x1216 (`lipjax export`'s default --samples), run under onnxruntim
 Printed per frame: samples, median, 99th percentile and max |ONNX - complete| over all pixels, in mm.
 
 --scattered: synthetic rooms (lipjax.data renders, test split) at 480x640 with 200 uniform points, where a model
-whose initial fill is "linear" or "auto" runs from the Delaunay fill under lipjax.complete but from the nearest
+whose initial estimate is "linear" or "auto" runs from the Delaunay fill under lipjax.complete but from the nearest
 fill in the graph (default model: the default indoor one; lip-any, "auto"). Printed per room: the RMSE against the
 rendered depth (metres) of the ONNX graph, of lipjax.complete with the model as shipped and with its nearest twin
 (lipjax.onnx_export.nearest_twin) without the check against the linear fill (cross_check=False, which the graph

@@ -12,7 +12,7 @@
 2. Host cost: milliseconds of CPU per frame for that work in one process, per source, at the 128x160 crop.
 3. Train step: images/s of the jitted supervised step of each named config at batch 8 on its training crop
    (compilation not timed), on this machine's JAX backend.
-Everything uses the configs' own samplers and initial fills (lip_cnn_indoor: z0 = linear fill on the host).
+Everything uses the configs' own samplers and initial estimates (lip_cnn_indoor: z0 = linear fill on the host).
 The first line gives the machine's 2048x2048 matmul rate, measured in the same run (benchmarks.common.matmul_rate).
 """
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """The paper's Fig. 4a: MAE against the number of ADMM iterations, for LIP+CNN and LIP+AD. Two ways:
 
   1. a trained K-iteration model evaluated after each of its iterations (its x-iterates: 0 prox steps = the
-     data-consistent initial fill, then one point per learned prox, the last being the model's output);
+     data-consistent initial estimate, then one point per learned prox, the last being the model's output);
   2. (--train-k 1,2,3,5) models trained from scratch with K = 1, 2, 3, 5 iterations for --train-steps steps each
      (a smaller budget than the shipped models; say so when reporting). A finished K-model already exported to
      --out/models (same config and budget) is reused, and a killed run resumes from its checkpoints in --out/runs,
@@ -115,7 +115,7 @@ def main(argv=None) -> dict:
     curves = {m: mae_per_iteration(load_model(m), dataset, sampler, config.limit, config.seed, protocol.max_depth_m)
               for m in models}
     doc = {"meta": {**dataclasses.asdict(config), "scene": args.scene,
-                    "x": "prox steps applied (0 = data-consistent initial fill)"}, "per_iteration_mae_m": curves}
+                    "x": "prox steps applied (0 = data-consistent initial estimate)"}, "per_iteration_mae_m": curves}
     lines = ["| model | " + " | ".join(f"{k} prox" for k in range(max(len(c) for c in curves.values()))) + " |"]
     lines.append("|---|" + "---:|" * (len(lines[0].split("|")) - 3))
     lines += [f"| {m} | " + " | ".join(f"{v:.4f}" for v in c) + " |" for m, c in curves.items()]

@@ -94,7 +94,7 @@ every sample, held out of its input in five folds, and leans on the fill on fram
 `--no-cross-check` runs the model alone, once instead of twice (six times where the first fold goes against it).
 `--explain` prints each frame's plan and stops: no model runs and nothing is written (no --out needed). A line per
 decision: the model; the samples' pattern (scan lines; scattered; few points, under 100; dense, a depth camera's
-map with holes), their number and spacing; the working size; the initial fill; flip averaging; residual
+map with holes), their number and spacing; the working size; the initial estimate; flip averaging; residual
 spreading; the check against the linear fill; whether the measured pixels are set back.
 
 Errors you can act on (unreadable files, misaligned or empty depth, a PNG without scale, unknown model, an output

@@ -1,5 +1,5 @@
 """Exports a trained model for a fixed input shape: as serialised StableHLO (`jax.export`, here), or as one ONNX
-graph with the initial fill and the resizes inside (lipjax.onnx_export, for onnxruntime: the deployment format).
+graph with the initial estimate and the resizes inside (lipjax.onnx_export, for onnxruntime: the deployment format).
 
     completer = lipjax.load_model("lip-ad-indoor")
     exported = export_completer(completer, batch=1, height=480, width=640)
@@ -54,7 +54,7 @@ from lipjax.methods import get_completer
 from lipjax.onnx_export import OnnxFile, export_onnx, need_onnx
 
 EXPORT_FORMATS = {".stablehlo": "serialised StableHLO for jax.export, which JAX runs",
-                  ".onnx": "one ONNX graph, initial fill and resizes inside, which onnxruntime runs"}
+                  ".onnx": "one ONNX graph, initial estimate and resizes inside, which onnxruntime runs"}
 """The formats `export` writes, by the extension of its output file."""
 
 
@@ -125,8 +125,9 @@ class ExportedCompleter:
         args = [rgb, sparse.astype(np.float32)]
         if self.needs_z0:
             if z0 is None or np.shape(z0) != (b, h, w):
-                raise ValueError(f"this exported model also takes z0 float32 {(b, h, w)} metres, its initial fill of "
-                                 "sparse (lipjax.model.host_initial_estimate with the model's initial_estimate)")
+                raise ValueError(f"this exported model also takes z0 float32 {(b, h, w)} metres, its initial "
+                                 "estimate of sparse (lipjax.model.host_initial_estimate with the model's "
+                                 "initial_estimate)")
             args.append(np.asarray(z0, np.float32))
         return np.asarray(self.exported.call(*args))
 
@@ -155,18 +156,18 @@ def export_format(path: str | os.PathLike) -> str:
 
 @dataclasses.dataclass(frozen=True)
 class ExportedFile:
-    """What `export` wrote: the file, the exported program, and the model's host-side initial fill ("linear",
+    """What `export` wrote: the file, the exported program, and the model's host-side initial estimate ("linear",
     "nearest"), which the program then takes as a third input z0; None when it takes two inputs."""
 
     path: pathlib.Path
     exported: jax.export.Exported
-    host_fill: str | None
+    z0_kind: str | None
 
     def summary(self) -> str:
         """One line: the file, its size and the program's signature (shapes, dtypes, metres) and platforms."""
         shape = tuple(int(d) for d in self.exported.in_avals[1].shape)
-        z0 = (f", z0 float32 {shape} m (the model's {self.host_fill} fill of sparse, computed outside: "
-              "lipjax.model.host_initial_estimate)") if self.host_fill else ""
+        z0 = (f", z0 float32 {shape} m (the model's {self.z0_kind} fill of sparse, computed outside: "
+              "lipjax.model.host_initial_estimate)") if self.z0_kind else ""
         return (f"wrote {self.path} ({self.path.stat().st_size} bytes): rgb uint8 {shape + (3,)}, sparse float32 "
                 f"{shape} m{z0} -> depth m; platforms {list(self.exported.platforms)}")
 

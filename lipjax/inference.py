@@ -2,7 +2,7 @@
 
 Also `load_model` (a saved model by name or path), `default_model` (the shipped default), and the default path of
 `lipjax.complete` and `lipjax complete` as data plus one function: `plan_frame` decides once per frame what happens
-to it (a frozen `FramePlan`: the samples' pattern, the working size, the initial fill, flip averaging, residual
+to it (a frozen `FramePlan`: the samples' pattern, the working size, the initial estimate, flip averaging, residual
 spreading, the cross-check), and `complete_frame` runs it stage by stage and returns full-size depth. The numbers
 and switches of the path are in lipjax.defaults. Names of every kind of completer (learned, classical, a path)
 resolve in lipjax.methods.get_completer.
@@ -62,7 +62,7 @@ class Completer:
 
     @classmethod
     def random(cls, config: LIPConfig | None = None, seed: int = 0) -> "Completer":
-        """An untrained model (its network prox is the identity, so it returns the initial fill)."""
+        """An untrained model (its network prox is the identity, so it returns the initial estimate)."""
         config = config or LIPConfig()
         return cls(config, config.init(jax.random.key(seed)), name="random")
 
@@ -75,7 +75,7 @@ class Completer:
         """Dense depth in metres, (H, W) or (B, H, W) like the input: the model itself, at the input's size.
 
         `scan_lines`: whether the samples lie in LiDAR scan lines, where the caller knows it (the default path's
-        `FramePlan`, asked of the full-size frame); the input checks and an "auto" initial fill take it instead of
+        `FramePlan`, asked of the full-size frame); the input checks and an "auto" initial estimate take it instead of
         asking lipjax.inputs.is_lidar_pattern of the map given here.
         `lipjax.complete(rgb, sparse, model=completer)` is the default path instead (`complete_frame`): the model at
         the working size of the samples (lipjax.resolution), every measured pixel set back. On 200 points on 480x640
@@ -184,8 +184,9 @@ class FramePlan:
       shape: the frame's (H, W). samples: how many pixels have a sample. pattern: `sample_pattern`'s answer.
       size: (h, w) the model runs at: the working size (lipjax.resolution), `max_side`'s size, or the frame's own.
       max_side: the caller's cap on the longer side, pixels (--max-side), or None.
-      fill: the initial estimate z_0 the model starts from at that size ("nearest", "linear", "box_fill", "sparse";
-        LIPConfig.initial_fill of the pattern); None for an end-to-end network or a hand-crafted method.
+      initial_estimate: the kind of z_0, the estimate the model starts from at that size ("nearest", "linear",
+        "box_fill", "sparse"; LIPConfig.initial_estimate_for of the pattern); None for an end-to-end network or a
+        hand-crafted method.
       flip: average the model's estimate with the flipped frame's (`flip_averaged`).
       spread: spread the samples' residuals over an estimate resized back to full size (lipjax.spread).
       cross_check: check the model against the linear fill on held-out samples (lipjax.crosscheck).
@@ -198,7 +199,7 @@ class FramePlan:
     pattern: str
     size: tuple[int, int]
     max_side: int | None
-    fill: str | None
+    initial_estimate: str | None
     flip: bool
     spread: bool
     cross_check: bool
@@ -238,7 +239,8 @@ class FramePlan:
                 f"pattern: {self.pattern} ({PATTERN_WORDS[self.pattern]}): {self.samples:,} samples on "
                 f"{big_h}x{big_w}, {spacing:.1f} px apart",
                 f"working size: {h}x{w} ({scale}; {why_size})",
-                f"initial fill: {self.fill or 'none'}" + ("" if self.learned else " (the method is the fill)"),
+                f"initial estimate z0: {self.initial_estimate or 'none'}"
+                + ("" if self.learned else " (the method is the fill)"),
                 f"flip averaging: {_on(self.flip)}",
                 f"residual spreading: {spreading}",
                 f"cross-check against the linear fill: {_on(self.cross_check)}" + self._unchecked(),
@@ -321,7 +323,7 @@ def plan_frame(completer, sparse_m: np.ndarray, max_side: int | None = None, *, 
                scan_lines: bool | None = None) -> FramePlan:
     """The `FramePlan` of `completer` on a frame with checked (H, W) samples `sparse_m` (metres; `one_frame`): the
     pattern asked once (`sample_pattern`; `scan_lines` when the caller knows it), and from it the working size
-    (`frame_size`; `size` instead when given, `max_side` to cap it), the model's initial fill, flip averaging
+    (`frame_size`; `size` instead when given, `max_side` to cap it), the model's initial estimate, flip averaging
     (`flips`: `flip`, None for the default), residual spreading (`spread`) and the cross-check (`cross_check`,
     for a learned model on SCATTERED samples). InputError for `flip` with a completer that is not learned."""
     learned = isinstance(completer, Completer)
@@ -333,7 +335,8 @@ def plan_frame(completer, sparse_m: np.ndarray, max_side: int | None = None, *, 
         model=getattr(completer, "name", type(completer).__name__), learned=learned, shape=tuple(sparse_m.shape),
         samples=int(np.count_nonzero(sparse_m > 0)), pattern=pattern, max_side=max_side,
         size=tuple(size) if size is not None else frame_size(completer, sparse_m, max_side, scan_lines=lines),
-        fill=completer.config.initial_fill(lines) if learned else None, flip=flips(completer, lines, flip),
+        initial_estimate=completer.config.initial_estimate_for(lines) if learned else None,
+        flip=flips(completer, lines, flip),
         spread=spread, cross_check=cross_check and learned and pattern == SCATTERED)
 
 
@@ -356,7 +359,7 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     if plan is None:
         plan = plan_frame(completer, sparse_m, max_side, flip=flip, cross_check=cross_check)
     # 3. the estimate from a set of samples at a size (`estimate_at`): the RGB and the samples to the working size,
-    #    the initial fill, the network (flip-averaged), the resize back, the residuals spread
+    #    the initial estimate, the network (flip-averaged), the resize back, the residuals spread
     estimate = functools.partial(estimate_at, completer, rgb, plan)
     # 4. with the cross-check: held-out folds, the model against the linear fill, blended where it is the worse
     if plan.cross_check:
@@ -375,7 +378,7 @@ def estimate_at(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarra
                 at: tuple[int, int]) -> np.ndarray:
     """z (H, W) float32 metres: `completer`'s estimate from the (H, W) samples `sparse_m` (the frame's, or those a
     cross-check fold keeps) run at `at` (h, w). Below full size the RGB is area-resized, the samples move onto the
-    small grid (`reproject_sparse`), the model runs there (from its initial fill of the plan's pattern, computed on
+    small grid (`reproject_sparse`), the model runs there (from its initial estimate of the plan's pattern, computed on
     the host; averaged with the flipped frame's estimate with plan.flip), its estimate is resized back (bilinear)
     and, with plan.spread, the samples' residuals y - z are spread over it (`lipjax.spread`; scan lines get their
     own sigmas). Measured pixels are not set back here (`complete_frame` does it, after any cross-check).
@@ -395,7 +398,7 @@ def estimate_at(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarra
 
 def model_run(completer, plan: FramePlan) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
     """(rgb, sparse) -> depth at their size, as the plan runs `completer`: a learned model told the frame's pattern
-    (its input checks and its initial fill then take it rather than asking lipjax.inputs.is_lidar_pattern of the
+    (its input checks and its initial estimate then take it rather than asking lipjax.inputs.is_lidar_pattern of the
     resized map), `flip_averaged` with plan.flip; any other completer as it is."""
     if not plan.learned:
         return completer

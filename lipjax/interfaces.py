@@ -107,7 +107,7 @@ class LearnedModel(abc.ABC):
         `scan_lines`: whether the samples lie in LiDAR scan lines, where the caller knows it (None: not known)."""
         return {}
 
-    def initial_fill(self, scan_lines: bool) -> str | None:
+    def initial_estimate_for(self, scan_lines: bool) -> str | None:
         """The initial estimate the model starts from on samples in LiDAR scan lines or not (`scan_lines`), by
         name; None (the default): none, the model takes the sparse map itself (an end-to-end network)."""
         return None

@@ -6,7 +6,7 @@
 Why a translator of our own and not jax2onnx (ARCHITECTURE.md, "ONNX"): jax2onnx 0.17.1 installs beside lipjax only
 with orbax-checkpoint held below 0.11.37 and some 25 packages lipjax does not use, and it exports the default graph
 only after two library functions are rewritten around its gaps; this module needs only the `onnx` package. It
-translates the primitives lipjax's inference graphs use (the LIP models, the initial fills, the resizes; PRIMITIVES
+translates the primitives lipjax's inference graphs use (the LIP models, the initial estimates, the resizes; PRIMITIVES
 lists them) and names any other one in a one-line NotImplementedError. Since the graph is the jaxpr of the function
 JAX runs, the exported model computes what the JAX model computes, to float32 rounding (tests/test_onnx_export.py
 checks each primitive and whole models under onnxruntime).

@@ -51,7 +51,7 @@ class LIPConfig(LearnedModel):
         (lipjax.fill, jit-able), so the first learned prox refines a dense map; measured pixels are kept by the
         x-update. "linear" / "nearest": Delaunay piecewise-linear / nearest-sample fill, computed on the host
         (`host_initial_estimate`) and passed to `apply` as z0. "auto": per frame, nearest for LiDAR scan lines
-        (`lipjax.inputs.is_lidar_pattern`), linear otherwise (benchmarks/initial_fill.py: with the same weights,
+        (`lipjax.inputs.is_lidar_pattern`), linear otherwise (benchmarks/initial_estimate.py: with the same weights,
         nearest is both better and ~8x cheaper on scan lines, linear better on scattered points of any density).
         With the zero-initialised residual prox an
         untrained model returns exactly this fill, so training starts from that classical baseline.
@@ -103,10 +103,10 @@ class LIPConfig(LearnedModel):
         frame), for the "auto" fill; None: "auto" asks lipjax.inputs.is_lidar_pattern of each map."""
         if not self.needs_host_initial_estimate:
             return {}
-        kind = self.initial_estimate if scan_lines is None else self.initial_fill(scan_lines)
+        kind = self.initial_estimate if scan_lines is None else self.initial_estimate_for(scan_lines)
         return {"z0": host_initial_estimate(kind, sparse)}
 
-    def initial_fill(self, scan_lines: bool) -> str:
+    def initial_estimate_for(self, scan_lines: bool) -> str:
         """z_0's kind on samples in LiDAR scan lines or not: `initial_estimate`, with "auto" resolved (nearest on
         scan lines, linear otherwise)."""
         if self.initial_estimate != "auto":
@@ -254,7 +254,7 @@ def host_initial_estimate(kind: str, sparse: np.ndarray) -> np.ndarray:
     from lipjax.classical.interpolate import linear_fill  # scipy-based; imported lazily (host only)
     from lipjax.classical.nearest import nearest_fill
 
-    def auto_fill(s):  # LIPConfig.initial_fill, its pattern asked of each map
+    def auto_fill(s):  # LIPConfig.initial_estimate_for, its pattern asked of each map
         return nearest_fill(s) if is_lidar_pattern(s) else linear_fill(s)
 
     fill = {"linear": linear_fill, "nearest": nearest_fill, "auto": auto_fill}[kind]

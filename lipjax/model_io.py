@@ -142,7 +142,7 @@ def table(defaults: dict[str, str]) -> str:
     """The shipped models as a text table in aligned columns (TABLE_COLUMNS), one row per model, from each model's
     config and metadata: DEFAULT names the scene(s) whose default it is (`default_mark`; `defaults`: scene ->
     name, e.g. lipjax.shipped.DEFAULT_MODELS), blank for the others; TYPE is "LIP, <prox>" or the end-to-end network's
-    type; ITERS and Z0 (the initial fill) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
+    type; ITERS and Z0 (the initial estimate) are LIP's; RANGE the max depth; VAL RMSE, metres, on VALIDATED ON
     (its sampler); IMAGES SEEN the training budget (metadata images_seen); "-" where unknown or not applicable."""
     rows = [TABLE_COLUMNS]
     for name in available():

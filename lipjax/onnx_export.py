@@ -22,7 +22,7 @@ than the one lipjax trains with, see that module):
      scattered samples it ends at DENSE samples a pixel, beyond which a dense map is capped as scan lines are.
   2. rgb -> (h, w) as cv2.resize(INTER_AREA) and its uint8 rounding; sparse -> (h, w) by reprojection, the
      nearest depth winning (lipjax.resample: gathers with constant tables, mins and sums).
-  3. z0, the initial fill, in the graph: the nearest-sample fill by jump flooding (lipjax.fill.jump_flood_nearest),
+  3. z0, the initial estimate, in the graph: the nearest-sample fill by jump flooding (lipjax.fill.jump_flood_nearest),
      which equals the host fill `host_initial_estimate("nearest", ...)` (ties broken as scipy breaks them)
      except at a few pixels in a million (tests/test_fill.py). The host's "linear" (Delaunay) fill has no
      fixed-size program, so a model whose initial_estimate is "linear" or "auto" runs from the nearest fill in
@@ -151,16 +151,16 @@ def inference_graph(completer: Completer, frame: tuple[int, int], working: tuple
     return run
 
 
-def _host_fill(config) -> str | None:
-    """The model's initial fill when it has no in-graph form ("linear" or "auto"), else None."""
+def _z0_kind(config) -> str | None:
+    """The model's initial estimate when it has no in-graph form ("linear" or "auto"), else None."""
     fill = config.initial_estimate if isinstance(config, LIPConfig) else None
     return fill if fill in ("linear", "auto") else None
 
 
 def nearest_twin(completer: Completer) -> Completer:
-    """The model with the initial fill its ONNX export computes: "nearest" where it is computed on the host."""
+    """The model with the initial estimate its ONNX export computes: "nearest" where it is computed on the host."""
     config = completer.config
-    if _host_fill(config) is None:
+    if _z0_kind(config) is None:
         return completer
     return Completer(dataclasses.replace(config, initial_estimate="nearest"), completer.params, completer.name,
                      completer.metadata)
@@ -169,14 +169,14 @@ def nearest_twin(completer: Completer) -> Completer:
 @dataclasses.dataclass(frozen=True)
 class OnnxFile:
     """What `export_onnx` wrote: the file, the input shape (B, H, W), the working size, the sample counts for which
-    that is lipjax.complete's working size, and the model's own initial fill when the graph's nearest fill replaced
+    that is lipjax.complete's working size, and the model's own initial estimate when the graph's nearest fill replaced
     it (else None); whether the graph averages with the flipped frame."""
 
     path: pathlib.Path
     shape: tuple[int, int, int]
     working: tuple[int, int]
     samples: tuple[int, int]
-    replaced_fill: str | None
+    replaced_z0: str | None
     flip: bool = False
 
     def summary(self) -> str:
@@ -186,9 +186,9 @@ class OnnxFile:
                  f"{(b, h, w)} m -> depth float32 {(b, h, w)} m (ONNX opset {jaxpr_to_onnx.OPSET}, fixed shape)",
                  f"working size {self.working[0]}x{self.working[1]}: lipjax.complete's for {self.samples[0]} to "
                  f"{self.samples[1]} samples per frame (--samples and --scattered set it)"]
-        if self.replaced_fill:
-            lines.append(f"initial fill: nearest, in the graph, instead of the model's {self.replaced_fill!r} (no "
-                         "ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
+        if self.replaced_z0:
+            lines.append(f"initial estimate z0: nearest, in the graph, instead of the model's {self.replaced_z0!r} "
+                         "(no ONNX form): equal to lipjax.complete on LiDAR scan lines only when that is 'auto'")
         if self.flip:
             lines.append("flip averaging in the graph (--no-flip: without, at half the work): equal to "
                          "lipjax.complete(..., flip=True, cross_check=False)")
@@ -218,11 +218,12 @@ def export_onnx(completer: Completer, out: str | os.PathLike, *, height: int, wi
     flip = flips(completer, scan_lines, flip)
     working = export_working_size(height, width, samples, scan_lines)
     interval = samples_interval(height, width, samples, scan_lines)
-    replaced = _host_fill(completer.config)
+    replaced = _z0_kind(completer.config)
     metadata = {"lipjax_model": completer.name, "units": "metres; sparse 0 = no sample",
                 "frame_size": f"{height}x{width}", "working_size": f"{working[0]}x{working[1]}",
                 "working_size_samples": f"{interval[0]}-{interval[1]}" + ("" if scan_lines else " scattered"),
-                "initial_fill": "nearest (jump flooding, in the graph)" + (f", not {replaced}" if replaced else ""),
+                "initial_estimate": "nearest (jump flooding, in the graph)"
+                                    + (f", not {replaced}" if replaced else ""),
                 "flip_averaged": str(bool(flip)).lower()}
     specs = [jax.ShapeDtypeStruct((batch, height, width, 3), jnp.uint8),
              jax.ShapeDtypeStruct((batch, height, width), jnp.float32)]

@@ -112,7 +112,7 @@ def test_convergence_smoke_with_a_saved_model(tmp_path):
     doc = convergence.main(["--variant", "smoke", "--models", str(tmp_path / "m"), "--out", str(tmp_path / "c")])
     curve = doc["per_iteration_mae_m"][str(tmp_path / "m")]
     assert len(curve) == 3 and all(np.isfinite(curve))
-    # an untrained (identity) prox leaves the data-consistent initial fill unchanged at every iteration
+    # an untrained (identity) prox leaves the data-consistent initial estimate unchanged at every iteration
     np.testing.assert_allclose(curve, curve[0], rtol=1e-4)
     assert (tmp_path / "c" / "convergence.png").exists()
 

@@ -118,7 +118,7 @@ def test_export_writes_the_model_and_a_summary_and_refuses_a_hand_crafted_fill(c
     from lipjax.export import export
 
     done = export(completer, tmp_path / "x" / "m.StableHLO", height=H, width=W)
-    assert done.path == tmp_path / "x" / "m.StableHLO" and done.host_fill is None
+    assert done.path == tmp_path / "x" / "m.StableHLO" and done.z0_kind is None
     rgb, sparse = _inputs()
     np.testing.assert_allclose(load_exported(done.path)(rgb[:1], sparse[:1]), completer(rgb[:1], sparse[:1]),
                                rtol=1e-5, atol=1e-5)

@@ -43,8 +43,8 @@ def test_single_and_batched_calls_agree_and_keep_measurements(completer, scrambl
     assert batched.shape == (2, 16, 20) and batched.dtype == np.float32
     np.testing.assert_allclose(completer(rgb[1], sparse[1]), batched[1], rtol=1e-5)
     m = sparse > 0
-    # An identity prox: z = x + u, so u stays 0 and every iterate is the initial fill z_0 = box_fill(y, m), which keeps
-    # the measured pixels; the x-updates (m y + rho z_0) / (m + rho) then leave it unchanged, at every pixel.
+    # An identity prox: z = x + u, so u stays 0 and every iterate is the initial estimate z_0 = box_fill(y, m), which
+    # keeps the measured pixels; the x-updates (m y + rho z_0) / (m + rho) then leave it unchanged, at every pixel.
     np.testing.assert_allclose(batched, np.asarray(box_fill(sparse, m.astype(np.float32))), rtol=1e-5)
     np.testing.assert_allclose(batched[m], sparse[m], rtol=1e-6)
     # A real prox mixes pixels: each element of a batch still sees only its own frame. (Random weights amplify the
@@ -311,7 +311,7 @@ def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
     model = lipjax.Completer.random(LIPConfig(prior=network_preset("tiny"), initial_estimate="auto"))
     (_, scan), (_, points) = street_and_room
     plan = inference.plan_frame(model, scan)
-    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.fill) == (
+    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.initial_estimate) == (
         "scan lines", True, True, False, "nearest")
     assert plan.size == (132, 455) and plan.spread and plan.set_back and plan.samples == np.count_nonzero(scan)
     lines = plan.describe()
@@ -320,7 +320,7 @@ def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
     assert lines[2] == ("working size: 132x455 (0.38x of 352x1216; the rule: samples about 16 px apart, at most "
                         "60,000 pixels for scan lines)")
     plan = inference.plan_frame(model, points)
-    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.fill, plan.size) == (
+    assert (plan.pattern, plan.scan_lines, plan.flip, plan.cross_check, plan.initial_estimate, plan.size) == (
         "scattered", False, False, True, "linear", (196, 261))
     lines = plan.describe()
     assert lines[1] == "pattern: scattered (100 or more, not in scan lines): 200 samples on 480x640, 39.2 px apart"
@@ -330,7 +330,7 @@ def test_the_plan_of_a_scan_and_of_scattered_points(street_and_room):
     assert (plan.size, plan.flip, plan.cross_check) == ((120, 160), True, False)
     assert "cross-check against the linear fill: off (turned off)" in plan.describe()
     plan = inference.plan_frame(methods.get_completer("linear"), scan)
-    assert (plan.learned, plan.size, plan.fill, plan.flip, plan.cross_check, plan.set_back) == (
+    assert (plan.learned, plan.size, plan.initial_estimate, plan.flip, plan.cross_check, plan.set_back) == (
         False, (352, 1216), None, False, False, False)
     with pytest.raises(lipjax.InputError, match="flip averaging is for learned models"):
         inference.plan_frame(methods.get_completer("linear"), scan, flip=True)

@@ -104,7 +104,7 @@ def test_a_resized_frame_equals_the_jax_graph_and_complete_with_the_nearest_fill
     h, w = 128, 160
     written = export_onnx(auto_model, tmp_path / "m.onnx", height=h, width=w, samples=10, scan_lines=False,
                           flip=flip)
-    assert written.working == (64, 80) and written.replaced_fill == "auto" and written.flip == bool(flip)
+    assert written.working == (64, 80) and written.replaced_z0 == "auto" and written.flip == bool(flip)
     assert "instead of the model's 'auto'" in written.summary() and "64x80" in written.summary()
     rng = np.random.default_rng(3)
     rgb = rng.integers(0, 256, (1, h, w, 3), dtype=np.uint8)

@@ -431,7 +431,7 @@ def test_a_second_signal_exits_at_once_and_the_handlers_are_restored():
 
 
 def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_path, capsys):
-    """An indoor model fine-tuned outdoors: another depth range and initial fill, the same parameter tree, are
+    """An indoor model fine-tuned outdoors: another depth range and initial estimate, the same parameter tree, are
     accepted (the saved parameters, unchanged); another architecture is a one-line error."""
     from lipjax import model_io
 

@@ -111,7 +111,7 @@ OUTDOOR = TrainConfig(
     inverse_depth_weight=1.0, inverse_depth_floor_m=1.0,
 )
 # Rooms and streets: the fast prox (it never sees a metric depth) from the "auto" fill (nearest on scan
-# lines, linear elsewhere: benchmarks/initial_fill.py), each frame's error in units of its own sample scale. No
+# lines, linear elsewhere: benchmarks/initial_estimate.py), each frame's error in units of its own sample scale. No
 # schedule: its config (fast.py, lip_any) sets it.
 MIXED = TrainConfig(
     name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, "auto"), data=MIXED_DATA,

@@ -18,7 +18,7 @@ Why each piece:
   1-10 m room and a 1-80 m street give inputs of the same range (OMNI-DC normalises its network input the same
   way), and the output is v * exp(residual): a relative correction, positive for any weights, independent of the
   metric scale. No max depth enters the network.
-- **Zero-initialised head**: an untrained G_k is the identity, so an untrained model returns its initial fill.
+- **Zero-initialised head**: an untrained G_k is the identity, so an untrained model returns its initial estimate.
 - **GroupNorm**, as in the paper-style G: no running statistics, the same at batch 1 and 8.
 
 Units: v, z and s in metres; the network works on dimensionless log ratios.

@@ -68,7 +68,7 @@ def _to_float(metrics: dict) -> dict:
 
 def _initial_g_params(config: TrainConfig):
     """The parameters of model `config.init_from`. Its config may differ from `config.model` only where the
-    parameters do not (e.g. an indoor model fine-tuned outdoors: another depth range, initial fill); a different
+    parameters do not (e.g. an indoor model fine-tuned outdoors: another depth range, initial estimate); a different
     parameter tree (names or shapes) is an error."""
     if config.init_from is None:
         return None

@@ -4,7 +4,7 @@ The model's own estimate is scored (`cross_check=False`, `flip=False`): the defa
 linear fill (lipjax.crosscheck) would mix that fill into what is measured here, and its flipped frame on scan lines
 (lipjax.inference.flips) a second estimate.
 
-    python -m benchmarks.initial_fill [--model lip-any] [--frames 4]
+    python -m benchmarks.initial_estimate [--model lip-any] [--frames 4]
 
 For synthetic test renders (never trained on) with sparse and dense inputs, the model runs through the default path
 (`lipjax.inference.complete_frame`, at its working size) twice: with z_0 the linear fill and with z_0 the nearest
