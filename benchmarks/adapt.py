@@ -56,8 +56,8 @@ def write_folder(root: pathlib.Path, frames) -> None:
     for split in ("train", "val"):
         for d in ("rgb", "sparse"):
             (root / split / d).mkdir(parents=True)
-        for i, (_, sample, sparse, _) in enumerate(frames):
-            cv2.imwrite(str(root / split / "rgb" / f"{i:02d}.png"), cv2.cvtColor(sample.rgb, cv2.COLOR_RGB2BGR))
+        for i, (_, frame, sparse, _) in enumerate(frames):
+            cv2.imwrite(str(root / split / "rgb" / f"{i:02d}.png"), cv2.cvtColor(frame.rgb, cv2.COLOR_RGB2BGR))
             np.save(root / split / "sparse" / f"{i:02d}.npy", sparse.astype(np.float32))
 
 
@@ -82,11 +82,11 @@ def scores(frames, models: dict[str, str | None]) -> dict[str, list[float]]:
     """RMSE ratio to linear of each of `models` (label -> model name or path) on each frame, printed a line a frame."""
     linear = get_completer("linear")
     out: dict[str, list[float]] = {label: [] for label in models}
-    for _, sample, sparse, input_name in frames:
+    for _, frame, sparse, input_name in frames:
         given = lambda s, seed, sparse=sparse: sparse  # noqa: E731 - the frame's own input, as a sampler
         for label, model in models.items():
-            out[label].append(ratio_to_linear(model, linear, sample, given))
-        print(f"  {sample.id.removeprefix('realdata/'):20s} {input_name:11s} "
+            out[label].append(ratio_to_linear(model, linear, frame, given))
+        print(f"  {frame.id.removeprefix('realdata/'):20s} {input_name:11s} "
               + "  ".join(f"{label} {out[label][-1]:.3f}" for label in models), flush=True)
     return out
 

@@ -15,7 +15,7 @@ Data sets (each a Markdown table: rows = methods, columns = metrics with units, 
              HDL-64 / VLP-16 patterns simulated on the ground truth, and 200 uniform points, (0, 80] m;
     middlebury2014_motorcycle  1 frame, 497x741 (full), depth from disparity, 200 and 500 uniform points,
              (0, 10] m.
-  Sparse inputs are drawn from the ground truth with the seed 0 and the sample id (lipjax.data.sampling), so
+  Sparse inputs are drawn from the ground truth with the seed 0 and the frame id (lipjax.data.sampling), so
   the sampled pixels are also scored: mae_unsampled_m is the error on the pixels the methods had to invent.
   Each real setting also gets a per-frame RMSE table, with the number of frames on which each method beats
   linear interpolation.

@@ -25,7 +25,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from lipjax.data import protocols
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.sampling import LidarSampler, UniformSampler, sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.data.synthetic.dataset import MixedSyntheticDataset
@@ -70,7 +70,7 @@ def read_pfm(path: str) -> np.ndarray:
     return np.flipud(data.reshape(h, w)).astype(np.float32)  # PFM rows are stored bottom-up
 
 
-def load_nyu(root: str) -> list[Sample]:
+def load_nyu(root: str) -> list[Frame]:
     """NYU v2 frames: depth PNG / 1000 = metres; standard NYU RGB intrinsics (PROVENANCE.md)."""
     k = Intrinsics(518.8579, 519.46961, 325.58245, 253.73617)
     out = []
@@ -78,11 +78,11 @@ def load_nyu(root: str) -> list[Sample]:
         idx = re.findall(r"\d+", name)[-1]
         rgb = read_rgb(os.path.join(root, "rgb", name))
         depth = read_png_depth(os.path.join(root, "depth", f"sync_depth_{idx}.png"), 1000.0)
-        out.append(Sample.from_depth(rgb, depth, k, f"realdata/nyu_v2/{idx}"))
+        out.append(Frame.from_depth(rgb, depth, k, f"realdata/nyu_v2/{idx}"))
     return out
 
 
-def load_kitti(root: str) -> list[Sample]:
+def load_kitti(root: str) -> list[Frame]:
     """KITTI frames: depth PNG / 256 = metres. Intrinsics: the 2011_09_26 P_rect_02 that matches the
     1242x375 size (the json's 2011_09_28 values are doubtful, see PROVENANCE.md)."""
     k = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
@@ -90,11 +90,11 @@ def load_kitti(root: str) -> list[Sample]:
     for name in sorted(os.listdir(os.path.join(root, "rgb"))):
         rgb = read_rgb(os.path.join(root, "rgb", name))
         depth = read_png_depth(os.path.join(root, "depth", name), 256.0)
-        out.append(Sample.from_depth(rgb, depth, k, f"realdata/kitti/{os.path.splitext(name)[0]}"))
+        out.append(Frame.from_depth(rgb, depth, k, f"realdata/kitti/{os.path.splitext(name)[0]}"))
     return out
 
 
-def load_middlebury(root: str) -> list[Sample]:
+def load_middlebury(root: str) -> list[Frame]:
     """Middlebury 2014 Motorcycle (quarter size): Z [mm] = baseline * f / (d + doffs); inf disparity = unknown."""
     calib = dict(line.strip().split("=", 1) for line in open(os.path.join(root, "calib.txt")) if "=" in line)
     cam0 = [float(v) for v in re.findall(r"[-\d.]+", calib["cam0"])]
@@ -104,23 +104,23 @@ def load_middlebury(root: str) -> list[Sample]:
     with np.errstate(divide="ignore", invalid="ignore"):
         depth_m = np.where(np.isfinite(disp), baseline_mm * f / (disp + doffs) / 1000.0, 0.0)
     rgb = read_rgb(os.path.join(root, "im0.png"))
-    return [Sample.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy),
-                              "realdata/middlebury/motorcycle")]
+    return [Frame.from_depth(rgb, depth_m.astype(np.float32), Intrinsics(f, f, cx, cy),
+                             "realdata/middlebury/motorcycle")]
 
 
-def load_lingbot(root: str) -> list[Sample]:
+def load_lingbot(root: str) -> list[Frame]:
     """lingbot frames: depth PNG / 1000 = metres (raw sensor depth), a 3x3 K per frame (PROVENANCE.md)."""
     out = []
     for name in sorted(os.listdir(os.path.join(root, "rgb"))):
         stem = os.path.splitext(name)[0]
         k = np.loadtxt(os.path.join(root, "intrinsics", f"{stem}.txt")).reshape(3, 3)
         depth = read_png_depth(os.path.join(root, "depth", f"{stem}.png"), 1000.0)
-        out.append(Sample.from_depth(read_rgb(os.path.join(root, "rgb", name)), depth,
-                                     Intrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2]), f"realdata/lingbot/{stem}"))
+        out.append(Frame.from_depth(read_rgb(os.path.join(root, "rgb", name)), depth,
+                                    Intrinsics(k[0, 0], k[1, 1], k[0, 2], k[1, 2]), f"realdata/lingbot/{stem}"))
     return out
 
 
-def load_real(root: str) -> tuple[list[Sample], list[Sample], list[Sample]]:
+def load_real(root: str) -> tuple[list[Frame], list[Frame], list[Frame]]:
     """The real frames under `root` as the benchmarks score them: NYU v2 (protocol nyu_paper), KITTI (kitti_paper),
     Middlebury (full size)."""
     nyu = [protocols.NYU_PAPER(s) for s in load_nyu(os.path.join(root, "nyu_v2"))]
@@ -128,14 +128,14 @@ def load_real(root: str) -> tuple[list[Sample], list[Sample], list[Sample]]:
     return nyu, kitti, load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
 
 
-def indoor_frames(root: str) -> list[Sample]:
+def indoor_frames(root: str) -> list[Frame]:
     """The 12 shared indoor frames at native size: NYU v2 (3), Middlebury Motorcycle (1), lingbot (8)."""
     indoor = load_nyu(os.path.join(root, "nyu_v2")) + load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
     return indoor + load_lingbot(os.path.join(root, "lingbot_rgbd"))
 
 
-def frames_and_inputs(root: str) -> list[tuple[str, Sample, np.ndarray, str]]:
-    """(group, sample, sparse input metres, input name) for every shared real frame at native size and input
+def frames_and_inputs(root: str) -> list[tuple[str, Frame, np.ndarray, str]]:
+    """(group, frame, sparse input metres, input name) for every shared real frame at native size and input
     setting: "indoor" (INDOOR_POINTS uniform points), "kitti-hdl64" (LidarSampler.hdl64) and "kitti-30pct"
     (KITTI_FRACTION of the valid pixels), all drawn with seed 0."""
     out = [("indoor", s, UniformSampler(INDOOR_POINTS)(s, 0), f"{INDOOR_POINTS} points") for s in indoor_frames(root)]
@@ -173,24 +173,24 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
     return list(SyntheticDataset(kind, "test", size=n, height=size[0], width=size[1], focal_range=focal))
 
 
-def ratio_to_linear(model, linear, sample, spec, cross_check: bool = CROSS_CHECK) -> float:
+def ratio_to_linear(model, linear, frame, spec, cross_check: bool = CROSS_CHECK) -> float:
     """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
     pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0;
     `cross_check` as in lipjax.inference.complete_at; without it the model's estimate itself, how models are compared:
     neither the check nor the flip averaging that the default path adds on scan lines (docs/decisions/0020)."""
-    return ratios_to_linear(model, linear, sample, spec, (sample.rgb,), cross_check)[0]
+    return ratios_to_linear(model, linear, frame, spec, (frame.rgb,), cross_check)[0]
 
 
-def ratios_to_linear(model, linear, sample, spec, images, cross_check: bool = CROSS_CHECK) -> list[float]:
-    """`ratio_to_linear` with each of `images` in place of the sample's own, the samples and the linear fill (which
+def ratios_to_linear(model, linear, frame, spec, images, cross_check: bool = CROSS_CHECK) -> list[float]:
+    """`ratio_to_linear` with each of `images` in place of the frame's own, the samples and the linear fill (which
     uses no image) computed once."""
-    sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(sample, 0)
-    keep = sample.valid & (sparse <= 0)
+    sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(frame, 0)
+    keep = frame.valid & (sparse <= 0)
 
     def rmse(pred):
-        return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
+        return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
 
-    completer, reference = get_completer(model, sparse=sparse), rmse(linear(sample.rgb, sparse))
+    completer, reference = get_completer(model, sparse=sparse), rmse(linear(frame.rgb, sparse))
     flip = None if cross_check else False  # the default path, or the model alone
     return [rmse(complete_frame(completer, rgb, sparse, flip=flip, cross_check=cross_check)) / reference
             for rgb in images]

@@ -36,9 +36,9 @@ def main(argv=None) -> None:
     linear, table = get_completer("linear"), {}
     print(f"{'setting':34s} {'model':18s} plain (wins)   checked (wins)")
     for name, model, kind, size, spec, variant in settings:
-        samples = frames(kind, size, variant, args.frames)
+        test_frames = frames(kind, size, variant, args.frames)
         r = np.asarray([[ratio_to_linear(model, linear, s, spec, check) for check in (False, True)]
-                        for s in samples])
+                        for s in test_frames])
         table[name] = {"model": model, "plain": r[:, 0].tolist(), "checked": r[:, 1].tolist()}
         gm = np.exp(np.log(r).mean(axis=0))
         wins = (r < 1).sum(axis=0)

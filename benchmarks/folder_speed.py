@@ -53,9 +53,9 @@ def write_frames(root: Path, count: int) -> None:
         return  # kept from an earlier run (--keep)
     sampler = LidarSampler.hdl64()
     for i in range(count):
-        sample = render("outdoor", "test", i, HEIGHT, WIDTH)
-        sparse = sampler(sample, 0)
-        cv2.imwrite(str(root / "rgb" / f"{i:06d}.png"), sample.rgb[..., ::-1])
+        frame = render("outdoor", "test", i, HEIGHT, WIDTH)
+        sparse = sampler(frame, 0)
+        cv2.imwrite(str(root / "rgb" / f"{i:06d}.png"), frame.rgb[..., ::-1])
         cv2.imwrite(str(root / "depth" / f"{i:06d}.png"), np.round(sparse * PNG_SCALE).astype(np.uint16))
 
 

@@ -24,9 +24,9 @@ from lipjax.interfaces import SCENE_MAX_DEPTH_M
 MAX_DEPTH_M = {"indoor": SCENE_MAX_DEPTH_M["indoor"], "outdoor": synthetic.RENDER_FAR_CLIP_M}
 
 
-def sparse_input(sample, kind: str) -> np.ndarray:
+def sparse_input(frame, kind: str) -> np.ndarray:
     """(H, W) sparse depth, 0 = no point."""
-    return sampler_from_spec("uniform:200" if kind == "indoor" else "lidar:hdl64")(sample)
+    return sampler_from_spec("uniform:200" if kind == "indoor" else "lidar:hdl64")(frame)
 
 
 def coloured(depth: np.ndarray, vmax: float, cmap) -> np.ndarray:

@@ -68,8 +68,8 @@ def main(argv=None) -> None:
         shipped = doc["ratios"]
     linear, table = get_completer("linear"), {}
     for name, kind, size, spec, variant in SETTINGS:
-        samples = frames(kind, size, variant, args.frames)
-        r = np.asarray([ratio_to_linear(args.model, linear, s, spec, args.cross_check) for s in samples])
+        test_frames = frames(kind, size, variant, args.frames)
+        r = np.asarray([ratio_to_linear(args.model, linear, s, spec, args.cross_check) for s in test_frames])
         table[name] = r.tolist()
         print(f"{name:30s} geometric mean {geometric_mean(r):.3f}  wins {int((r < 1).sum())}/{len(r)}",
               flush=True)

@@ -52,16 +52,16 @@ def main(argv=None) -> None:
     for kind, h, w, spec in SETTINGS:
         sampler = sampler_from_spec(spec)
         ratios, times, spacings = {k: [] for k in variants}, {k: [] for k in variants}, []
-        for sample in SyntheticDataset(kind, "test", size=args.frames, height=h, width=w):
-            sparse = sampler(sample, 0)
-            keep = sample.valid & (sparse <= 0)
-            ref = np.sqrt(np.mean((linear(sample.rgb, sparse)[keep] - sample.depth[keep]) ** 2))
+        for frame in SyntheticDataset(kind, "test", size=args.frames, height=h, width=w):
+            sparse = sampler(frame, 0)
+            keep = frame.valid & (sparse <= 0)
+            ref = np.sqrt(np.mean((linear(frame.rgb, sparse)[keep] - frame.depth[keep]) ** 2))
             spacings.append(sample_spacing_px(reproject_sparse(sparse, frame_size(base, sparse))))
             for k, completer in variants.items():
                 t = time.perf_counter()
-                pred = complete_frame(completer, sample.rgb, sparse, flip=False, cross_check=False)
+                pred = complete_frame(completer, frame.rgb, sparse, flip=False, cross_check=False)
                 times[k].append(time.perf_counter() - t)
-                ratios[k].append(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)) / ref)
+                ratios[k].append(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)) / ref)
         gm = {k: float(np.exp(np.mean(np.log(r)))) for k, r in ratios.items()}
         ms = {k: 1e3 * float(np.median(t[1:] or t)) for k, t in times.items()}
         print(f"| {kind} {h}x{w} {spec} | {np.median(spacings):.1f} | {gm['linear']:.3f} | {gm['nearest']:.3f} | "

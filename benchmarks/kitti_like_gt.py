@@ -36,14 +36,14 @@ PITCH_DEG = (-0.2, 0.2)  # and their pitch: the car rocks, so beams do not fall 
 AZIMUTH_STEP_DEG = 0.09  # the HDL-64's finest azimuth step
 
 
-def kitti_like_mask(sample) -> np.ndarray:
-    """(H, W) bool: the sample's valid pixels that one of the SWEEPS accumulated HDL-64 patterns hits."""
-    hit = np.zeros(sample.valid.shape, bool)
+def kitti_like_mask(frame) -> np.ndarray:
+    """(H, W) bool: the frame's valid pixels that one of the SWEEPS accumulated HDL-64 patterns hits."""
+    hit = np.zeros(frame.valid.shape, bool)
     for forward, pitch in zip(np.linspace(*FORWARD_M, SWEEPS), np.linspace(*PITCH_DEG, SWEEPS)):
         sweep = LidarSampler.hdl64(mount_forward_m=float(forward), mount_pitch_deg=float(pitch),
                                    azimuth_step_deg=AZIMUTH_STEP_DEG)
-        hit |= sweep(sample, 0) > 0
-    return hit & sample.valid
+        hit |= sweep(frame, 0) > 0
+    return hit & frame.valid
 
 
 def ratio(pred: np.ndarray, ref: np.ndarray, gt: np.ndarray, keep: np.ndarray) -> float:
@@ -51,7 +51,7 @@ def ratio(pred: np.ndarray, ref: np.ndarray, gt: np.ndarray, keep: np.ndarray) -
     return float(np.sqrt(np.mean((pred[keep] - gt[keep]) ** 2) / np.mean((ref[keep] - gt[keep]) ** 2)))
 
 
-def draw(path: str, model, sample, sparse: np.ndarray, pred: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> None:
+def draw(path: str, model, frame, sparse: np.ndarray, pred: np.ndarray, ref: np.ndarray, mask: np.ndarray) -> None:
     """The --figure of one street (module docstring); `pred` is the default path's estimate, with the spread."""
     import matplotlib
 
@@ -59,11 +59,11 @@ def draw(path: str, model, sample, sparse: np.ndarray, pred: np.ndarray, ref: np
     import matplotlib.pyplot as plt
 
     keep = mask & (sparse <= 0)
-    plain = complete_at(model, sample.rgb, sparse, frame_size(model, sparse), spread=False)
-    panels = [("the image", sample.rgb), ("KITTI-like mask (white)", keep)]
+    plain = complete_at(model, frame.rgb, sparse, frame_size(model, sparse), spread=False)
+    panels = [("the image", frame.rgb), ("KITTI-like mask (white)", keep)]
     for name, estimate in (("without", plain), ("with", pred)):
-        diff = np.where(keep, (estimate - sample.depth) ** 2 - (ref - sample.depth) ** 2, np.nan)
-        rmse = ratio(estimate, ref, sample.depth, keep)
+        diff = np.where(keep, (estimate - frame.depth) ** 2 - (ref - frame.depth) ** 2, np.nan)
+        rmse = ratio(estimate, ref, frame.depth, keep)
         panels.append((f"model SE - linear SE, {name} spreading ({rmse:.3f}x linear RMSE)", diff))
     fig, axes = plt.subplots(len(panels), 1, figsize=(12, 3.4 * len(panels)))
     for ax, (title, image) in zip(axes, panels):
@@ -92,15 +92,15 @@ def main(argv=None) -> None:
     sampler = sampler_from_spec(args.sampler)
     every, kitti = [], []
     for i in tqdm(range(args.start, args.start + args.frames), desc="streets", unit="frame"):
-        sample = streets[i]
-        sparse = sampler(sample, 0)
-        pred, ref = complete_frame(model, sample.rgb, sparse), linear(sample.rgb, sparse)
+        frame = streets[i]
+        sparse = sampler(frame, 0)
+        pred, ref = complete_frame(model, frame.rgb, sparse), linear(frame.rgb, sparse)
         unsampled = sparse <= 0
-        every.append(ratio(pred, ref, sample.depth, sample.valid & unsampled))
-        mask = kitti_like_mask(sample)
-        kitti.append(ratio(pred, ref, sample.depth, mask & unsampled))
+        every.append(ratio(pred, ref, frame.depth, frame.valid & unsampled))
+        mask = kitti_like_mask(frame)
+        kitti.append(ratio(pred, ref, frame.depth, mask & unsampled))
         if args.figure and i == args.start:
-            draw(args.figure, model, sample, sparse, pred, ref, mask)
+            draw(args.figure, model, frame, sparse, pred, ref, mask)
         tqdm.write(f"frame {i:3d}: every pixel {every[-1]:.4f}, KITTI-like mask {kitti[-1]:.4f} "
                    f"({mask.mean():.0%} of the pixels)")
     print(f"{args.model} on {args.frames} test streets {STREET[0]}x{STREET[1]}, {args.sampler}, RMSE ratio to linear "

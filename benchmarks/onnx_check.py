@@ -53,11 +53,11 @@ def kitti(model: str, root: str, out: str) -> None:
     written = export_onnx(completer, os.path.join(out, "kitti.onnx"), height=h, width=w)
     print(written.summary())
     session = _session(os.fspath(written.path))
-    for sample in frames:
-        sparse = LidarSampler.hdl64()(sample, 0)
-        got, = session.run(None, {"rgb": sample.rgb[None], "sparse": sparse[None]})
-        expected = complete(sample.rgb, sparse, model=completer)
-        print(f"{sample.id}: {int((sparse > 0).sum())} samples; |ONNX - lipjax.complete|: "
+    for frame in frames:
+        sparse = LidarSampler.hdl64()(frame, 0)
+        got, = session.run(None, {"rgb": frame.rgb[None], "sparse": sparse[None]})
+        expected = complete(frame.rgb, sparse, model=completer)
+        print(f"{frame.id}: {int((sparse > 0).sum())} samples; |ONNX - lipjax.complete|: "
               f"{_stats_mm(got[0], expected)}")
 
 
@@ -73,14 +73,14 @@ def scattered(model: str, frames: int, out: str) -> None:
                ("lipjax.complete, nearest twin", nearest_twin(completer)))
     errors = {label: [] for label, _ in methods}
     for i in range(frames):
-        sample = render("indoor", "test", i, 480, 640)
-        sparse = UniformSampler(200)(sample, 0)
-        got, = session.run(None, {"rgb": sample.rgb[None], "sparse": sparse[None]})
-        valid = sample.valid & (sample.depth > 0)
+        frame = render("indoor", "test", i, 480, 640)
+        sparse = UniformSampler(200)(frame, 0)
+        got, = session.run(None, {"rgb": frame.rgb[None], "sparse": sparse[None]})
+        valid = frame.valid & (frame.depth > 0)
         line = []
         for label, c in methods:
-            depth = got[0] if c is None else complete(sample.rgb, sparse, model=c, cross_check=c is completer)
-            errors[label].append(float(np.sqrt(np.mean((depth[valid] - sample.depth[valid]) ** 2))))
+            depth = got[0] if c is None else complete(frame.rgb, sparse, model=c, cross_check=c is completer)
+            errors[label].append(float(np.sqrt(np.mean((depth[valid] - frame.depth[valid]) ** 2))))
             line.append(f"{label} RMSE {errors[label][-1]:.4f} m" + ("" if c is None else
                                                                     f", |ONNX - it| {_stats_mm(got[0], depth)}"))
         print(f"room {i}: " + "; ".join(line))

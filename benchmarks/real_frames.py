@@ -50,7 +50,7 @@ import time
 import numpy as np
 
 from benchmarks.common import GREY, REALDATA, frames_and_inputs, geometric_mean, load_kitti
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 from lipjax.data.sampling import LidarSampler, example_rng
 from lipjax.inference import complete_at, complete_frame, frame_size
 from lipjax.inputs import is_lidar_pattern
@@ -65,9 +65,9 @@ HIDDEN_METHODS = ("linear", "ip_basic")
 CHECKS = ("dense ground truth", "hidden points", "hidden beams")
 
 
-def rmse(pred: np.ndarray, sample: Sample, sparse: np.ndarray) -> float:
-    keep = sample.valid & (sparse <= 0)
-    return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
+def rmse(pred: np.ndarray, frame: Frame, sparse: np.ndarray) -> float:
+    keep = frame.valid & (sparse <= 0)
+    return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
 
 
 def summary(ratios: list[float]) -> str:
@@ -76,29 +76,29 @@ def summary(ratios: list[float]) -> str:
     return f"wins {int((r < 1).sum())}/{len(r)}, median {np.median(r):.3f}, geometric mean {gm:.3f}"
 
 
-def beam_index(sample: Sample, sparse: np.ndarray, sampler: LidarSampler = KITTI_LIDAR) -> np.ndarray:
+def beam_index(frame: Frame, sparse: np.ndarray, sampler: LidarSampler = KITTI_LIDAR) -> np.ndarray:
     """(H, W) int64: the beam (0 = the lowest) that drew each input point of `sparse`, -1 where there is none.
 
     As `sampler` draws them: the valid ground-truth pixel back-projected into the LiDAR frame (LidarSampler.angles),
     its elevation rounded to the nearest beam elevation. The sampler keeps a pixel only within half a beam spacing
     of a beam, so every input point gets the beam that drew it."""
-    idx, elevation, _, _ = sampler.angles(sample)
+    idx, elevation, _, _ = sampler.angles(frame)
     beams = np.radians(sampler.beam_elevations_deg())
     spacing = (beams[-1] - beams[0]) / (sampler.beams - 1)
     label = np.full(sparse.size, -1, np.int64)
     label[idx] = np.clip(np.rint((elevation - beams[0]) / spacing), 0, sampler.beams - 1)
     label = np.where(sparse.reshape(-1) > 0, label, -1).reshape(sparse.shape)
     if np.any((sparse > 0) & (label < 0)):
-        raise ValueError(f"{sample.id}: input points off the valid ground truth, so off the sampler's pixels")
+        raise ValueError(f"{frame.id}: input points off the valid ground truth, so off the sampler's pixels")
     return label
 
 
-def hide_points(sample: Sample, sparse: np.ndarray, fraction: float = HIDDEN_FRACTION,
+def hide_points(frame: Frame, sparse: np.ndarray, fraction: float = HIDDEN_FRACTION,
                 seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(input without the hidden points, hidden mask): round(fraction x points) of the input's points, drawn by
-    `example_rng(seed, sample.id, "hidden")`."""
+    `example_rng(seed, frame.id, "hidden")`."""
     idx = np.flatnonzero(sparse > 0)
-    chosen = example_rng(seed, sample.id, "hidden").choice(idx, int(round(fraction * idx.size)), replace=False)
+    chosen = example_rng(seed, frame.id, "hidden").choice(idx, int(round(fraction * idx.size)), replace=False)
     hidden = np.zeros(sparse.size, bool)
     hidden[chosen] = True
     hidden = hidden.reshape(sparse.shape)
@@ -116,33 +116,33 @@ def hide_beams(beams: np.ndarray, sparse: np.ndarray,
     return np.where(hidden, 0.0, sparse).astype(np.float32), hidden, len(present), len(hidden_beams)
 
 
-def errors(pred: np.ndarray, sample: Sample, mask: np.ndarray) -> tuple[float, float]:
+def errors(pred: np.ndarray, frame: Frame, mask: np.ndarray) -> tuple[float, float]:
     """(RMSE, MAE) in metres of `pred` against the ground truth on `mask`."""
-    e = pred[mask] - sample.depth[mask]
+    e = pred[mask] - frame.depth[mask]
     return float(np.sqrt(np.mean(e ** 2))), float(np.mean(np.abs(e)))
 
 
-def hidden_checks(kitti: list[tuple[Sample, np.ndarray]], model, flip) -> list[dict]:
+def hidden_checks(kitti: list[tuple[Frame, np.ndarray]], model, flip) -> list[dict]:
     """The checks near the samples (module docstring) on each (KITTI frame, its HDL-64 input): one row per frame
     and check, with (RMSE, MAE) of "default" and of each of HIDDEN_METHODS."""
     methods = [get_completer(m) for m in HIDDEN_METHODS]
     rows = []
-    for sample, sparse in kitti:
-        beams = beam_index(sample, sparse)
+    for frame, sparse in kitti:
+        beams = beam_index(frame, sparse)
         kept, hidden, n_beams, n_hidden = hide_beams(beams, sparse)
-        inputs = {"dense ground truth": (sparse, sample.valid & (sparse <= 0), ""),
-                  "hidden points": (*hide_points(sample, sparse), ""),
+        inputs = {"dense ground truth": (sparse, frame.valid & (sparse <= 0), ""),
+                  "hidden points": (*hide_points(frame, sparse), ""),
                   "hidden beams": (kept, hidden, f"{n_hidden} of {n_beams} beams")}
         for check, (given, mask, note) in inputs.items():
             completer = get_completer(model, sparse=given)
-            row = {"frame": sample.id, "check": check, "input_points": int((given > 0).sum()),
+            row = {"frame": frame.id, "check": check, "input_points": int((given > 0).sum()),
                    "scored_points": int(mask.sum()), "note": note, "model": completer.name,
                    "working_size": list(frame_size(completer, given)),
-                   "default": errors(complete(sample.rgb, given, model, flip=flip), sample, mask)}
+                   "default": errors(complete(frame.rgb, given, model, flip=flip), frame, mask)}
             for m in methods:
-                row[m.name] = errors(m(sample.rgb, given), sample, mask)
+                row[m.name] = errors(m(frame.rgb, given), frame, mask)
             rows.append(row)
-            print(f"{sample.id:24s} {check:19s} {note:16s} input {row['input_points']:6d} scored "
+            print(f"{frame.id:24s} {check:19s} {note:16s} input {row['input_points']:6d} scored "
                   f"{row['scored_points']:6d}  " + "  ".join(
                       f"{n} {row[n][0]:.3f}/{row[n][1]:.3f} m" for n in ("default", *HIDDEN_METHODS)), flush=True)
     return rows
@@ -224,26 +224,26 @@ def frame_rows(inputs, args) -> list[dict]:
     and the --classical methods (and the --sweep)."""
     linear, classical = get_completer("linear"), [get_completer(m) for m in args.classical.split(",") if m]
     rows = []
-    for group, sample, sparse, input_name in inputs:
+    for group, frame, sparse, input_name in inputs:
         completer = get_completer(args.model, sparse=sparse)
-        grey = np.full_like(sample.rgb, GREY)
-        ref = rmse(linear(sample.rgb, sparse), sample, sparse)
+        grey = np.full_like(frame.rgb, GREY)
+        ref = rmse(linear(frame.rgb, sparse), frame, sparse)
         t0 = time.perf_counter()
-        pred = complete_frame(completer, sample.rgb, sparse, flip=args.flip)
+        pred = complete_frame(completer, frame.rgb, sparse, flip=args.flip)
         ms = 1e3 * (time.perf_counter() - t0)
-        row = {"group": group, "frame": sample.id, "input": input_name, "size": list(sample.shape),
+        row = {"group": group, "frame": frame.id, "input": input_name, "size": list(frame.shape),
                "model": completer.name, "working_size": list(frame_size(completer, sparse)),
-               "linear_rmse_m": ref, "default": rmse(pred, sample, sparse) / ref,
-               "grey": rmse(complete_frame(completer, grey, sparse, flip=args.flip), sample, sparse) / ref,
+               "linear_rmse_m": ref, "default": rmse(pred, frame, sparse) / ref,
+               "grey": rmse(complete_frame(completer, grey, sparse, flip=args.flip), frame, sparse) / ref,
                "ms": ms}
         for method in classical:
-            row[method.name] = rmse(method(sample.rgb, sparse), sample, sparse) / ref
+            row[method.name] = rmse(method(frame.rgb, sparse), frame, sparse) / ref
         if args.sweep:
             spacing, lines = sample_spacing_px(sparse), is_lidar_pattern(sparse)
-            row["sweep"] = {str(t): rmse(complete_at(completer, sample.rgb, sparse, _sweep_size(
-                sample.shape, spacing, t, lines), flip=args.flip), sample, sparse) / ref for t in SWEEP_TARGETS_PX}
+            row["sweep"] = {str(t): rmse(complete_at(completer, frame.rgb, sparse, _sweep_size(
+                frame.shape, spacing, t, lines), flip=args.flip), frame, sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
-        print(f"{sample.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
+        print(f"{frame.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "
               f"linear {ref:.3f} m  default {row['default']:.3f}  grey {row['grey']:.3f}  "
               + "  ".join(f"{m.name} {row[m.name]:.3f}" for m in classical) + f"  {ms:.0f} ms", flush=True)
     return rows

@@ -76,13 +76,13 @@ def finished(completer, rgb: np.ndarray, sparse_m: np.ndarray) -> dict[str, np.n
     return out
 
 
-def ratios(completer, sample, sparse_m: np.ndarray) -> dict[str, float]:
+def ratios(completer, frame, sparse_m: np.ndarray) -> dict[str, float]:
     """RMSE(variant) / RMSE(all) over the valid ground-truth pixels, measured ones included."""
-    maps = finished(completer, sample.rgb, sparse_m)
-    keep = sample.valid
+    maps = finished(completer, frame.rgb, sparse_m)
+    keep = frame.valid
 
     def rmse(pred):
-        return float(np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2)))
+        return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
 
     base = rmse(maps["all"])
     return {v: rmse(maps[v]) / base for v in VARIANTS}

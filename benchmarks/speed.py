@@ -57,8 +57,8 @@ def main(argv=None) -> None:
           "cores\n")
     frames = []
     for title, kind, h, w, sampler in SIZES:
-        sample = render(kind, "test", 0, h, w)
-        frames.append((title, sample.rgb, sampler(sample, 0)))
+        frame = render(kind, "test", 0, h, w)
+        frames.append((title, frame.rgb, sampler(frame, 0)))
     names = [m for m in args.models.split(",") if m] + [m for m in args.classical.split(",") if m]
     print("| method | " + " | ".join(f"{t}: ms (fps @195)" for t, _, _ in frames) + " |")
     print("|---|" + "---|" * len(frames))

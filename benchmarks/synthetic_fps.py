@@ -6,7 +6,7 @@ Run by hand (not a test); pin to one core so the number means "per core":
 
 Prints frames/s for indoor and outdoor at 256x320 and 128x160: mean over `--frames` consecutive indices
 (different scenes) after 2 warm-up frames, whole `render()` calls (scene building, ray casting, shading,
-camera model, Sample construction). Two numbers: wall-clock frames/s, and frames/s of CPU time
+camera model, Frame construction). Two numbers: wall-clock frames/s, and frames/s of CPU time
 (time.process_time): on a machine shared with other jobs the process is descheduled part of the time, and
 the CPU-time figure is then the better estimate of what one dedicated core delivers. The load average is
 printed so the numbers can be judged.

@@ -138,7 +138,7 @@ def train_step_rate(name: str, steps: int) -> tuple[float, tuple[int, int]]:
     arrays = {"rgb": rng.integers(0, 256, (BATCH, h, w, 3), dtype=np.uint8), "sparse": sparse,
               "gt": rng.uniform(1, 9, (BATCH, h, w)).astype(np.float32), "gt_valid": np.ones((BATCH, h, w), bool)}
     from lipjax.data.pipeline import with_host_inputs
-    from lipjax.data.sample import Batch
+    from lipjax.data.frame import Batch
 
     batch = shard_batch(with_host_inputs(config.model, Batch(**arrays)))
     state, step = init_state(config), make_steps(config).supervised

@@ -58,15 +58,15 @@ def real_settings(root: str):
              INDOOR_RANGE_M)]
 
 
-def frame_rows(method, sample, sampler, depth_range):
+def frame_rows(method, frame, sampler, depth_range):
     """(features, |error|) of one frame's scored pixels: columns r, depth range (m), height above (spacings), z (m),
     expected error (m)."""
-    sparse = sampler(sample, 0)
-    depth = np.asarray(method(sample.rgb, sparse), np.float32)
+    sparse = sampler(frame, 0)
+    depth = np.asarray(method(frame.rgb, sparse), np.float32)
     f = uncertainty.support_features(sparse)
     u = uncertainty.expected_error(sparse, depth)
-    gt = sample.depth
-    scored = sample.valid & (gt > depth_range[0]) & (gt <= depth_range[1]) & (sparse == 0)
+    gt = frame.depth
+    scored = frame.valid & (gt > depth_range[0]) & (gt <= depth_range[1]) & (sparse == 0)
     cols = [f["distance"], f["depth_range"], f["height_above"], depth, u]
     return np.stack([c[scored] for c in cols], axis=1), np.abs(depth - gt)[scored]
 

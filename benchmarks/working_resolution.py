@@ -60,16 +60,16 @@ def run(model: str, frames: int) -> dict:
     for kind, h, w, spec in SETTINGS:
         dataset, sampler = SyntheticDataset(kind, "test", size=frames, height=h, width=w), sampler_from_spec(spec)
         ratios, patterns = {rule: [] for rule in RULES}, set()
-        for sample in dataset:
-            sparse = sampler(sample, 0)
+        for frame in dataset:
+            sparse = sampler(frame, 0)
             patterns.add(is_lidar_pattern(sparse))
-            ref = rmse_unsampled(linear(sample.rgb, sparse), sample.depth, sample.valid, sparse)
+            ref = rmse_unsampled(linear(frame.rgb, sparse), frame.depth, frame.valid, sparse)
             spacing, by_size = sample_spacing_px(sparse), {}
             for t, p in RULES:
                 size = working_size((h, w), spacing, t, p)
                 if size not in by_size:  # rules that give the same size share one run
-                    pred = complete_at(completer, sample.rgb, sparse, size, flip=False, cross_check=False)
-                    by_size[size] = rmse_unsampled(pred, sample.depth, sample.valid, sparse) / ref
+                    pred = complete_at(completer, frame.rgb, sparse, size, flip=False, cross_check=False)
+                    by_size[size] = rmse_unsampled(pred, frame.depth, frame.valid, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"
         if len(patterns) > 1:

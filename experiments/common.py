@@ -12,7 +12,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 from lipjax.evaluate import EvalResult, evaluate, markdown_table
 from lipjax.inference import Completer
 from lipjax.methods import get_completer
@@ -103,7 +103,7 @@ def key_methods(results: dict[str, EvalResult], completers: dict[str, Any], coun
     return [m for m in results if m in chosen]
 
 
-def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inputs: Sequence[np.ndarray],
+def qualitative_figure(path: pathlib.Path, frames: Sequence[Frame], sparse_inputs: Sequence[np.ndarray],
                        completers: dict[str, Any], results: dict[str, EvalResult], max_depth_m: float,
                        max_error_m: float, sparse_title: str = "sparse input") -> None:
     """The paper's Fig. 3 as a grid: per frame, RGB | sparse input | ground truth | the key methods' predictions
@@ -111,10 +111,11 @@ def qualitative_figure(path: pathlib.Path, samples: Sequence[Sample], sparse_inp
     from lipjax import viz
 
     shown = key_methods(results, completers)
-    frames = [viz.Comparison(sample.id, sample.rgb, sparse, sample.depth,
-                             {name: np.asarray(completers[name](sample.rgb, sparse)) for name in shown}, sample.valid)
-              for sample, sparse in zip(samples, sparse_inputs)]
-    viz.save_comparison_grid(path, frames, max_depth_m, max_error_m, sparse_title=sparse_title)
+    comparisons = [viz.Comparison(frame.id, frame.rgb, sparse, frame.depth,
+                                  {name: np.asarray(completers[name](frame.rgb, sparse)) for name in shown},
+                                  frame.valid)
+                   for frame, sparse in zip(frames, sparse_inputs)]
+    viz.save_comparison_grid(path, comparisons, max_depth_m, max_error_m, sparse_title=sparse_title)
 
 
 def line_plot(path: pathlib.Path, xs: Sequence[float], series: dict[str, Sequence[float]], *, xlabel: str,

@@ -48,14 +48,14 @@ def mae_per_iteration(model, dataset, sampler, limit: int, seed: int, max_depth_
     """Mean over images of MAE (m) of x_1 .. x_K (before each prox) and of the final output: K + 1 values."""
     per_k: list[MetricAggregator] = []
     for i in range(min(limit, len(dataset))):
-        sample = dataset[i]
-        sparse = sampler(sample, seed)
-        final, trajectory = model.trajectory(sample.rgb, sparse)
+        frame = dataset[i]
+        sparse = sampler(frame, seed)
+        final, trajectory = model.trajectory(frame.rgb, sparse)
         iterates = [np.asarray(x[0]) for x in trajectory.x] + [np.asarray(final[0])]
         if not per_k:
             per_k = [MetricAggregator() for _ in iterates]
         for agg, pred in zip(per_k, iterates):
-            agg.add(compute_metrics(pred, sample.depth, sample.valid, min_depth_m=0.0, max_depth_m=max_depth_m))
+            agg.add(compute_metrics(pred, frame.depth, frame.valid, min_depth_m=0.0, max_depth_m=max_depth_m))
     return [agg.means()["mae_m"] for agg in per_k]
 
 

@@ -14,13 +14,13 @@
 source) in one place; `evaluate_methods` scores every method on it.
 
 The evaluation protocol, in one place:
-  - the sparse input of each sample is `sampler(sample, seed)`; samplers derive their randomness from the
-    sample id and this seed, so every method sees the same inputs and reruns are identical;
+  - the sparse input of each frame is `sampler(frame, seed)`; samplers derive their randomness from the
+    frame id and this seed, so every method sees the same inputs and reruns are identical;
   - metrics are per image over valid ground truth in (min_depth_m, max_depth_m], then averaged over images
     (see lipjax.metrics);
   - time per frame is the wall-clock time of the completer call alone (sampling and metrics excluded), including
     the conversion of its output to numpy, which waits for asynchronous JAX computations to finish. The first
-    call on a new image shape of a jitted model compiles, so one untimed warm-up call on the first sample
+    call on a new image shape of a jitted model compiles, so one untimed warm-up call on the first frame
     precedes the timed pass (that frame is then run again, timed). Times depend on the machine and its load.
 """
 from __future__ import annotations
@@ -39,15 +39,15 @@ from typing import Any
 import numpy as np
 
 from lipjax.interfaces import DepthCompleter
+from lipjax.data.frame import Frame
 from lipjax.data.protocols import EvalProtocol
-from lipjax.data.sample import Sample
 from lipjax.data.sampling import DEFAULT_SAMPLER
 from lipjax.data.sources import OWN_INPUT, Source, open_source, range_protocol
 from lipjax.inference import AtWorkingSize
 from lipjax.methods import get_completer
 from lipjax.metrics import DEFAULT_PRED_FLOOR_M, MetricAggregator, compute_metrics
 
-Sampler = Callable[[Sample, int], np.ndarray]  # (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample
+Sampler = Callable[[Frame, int], np.ndarray]  # (frame, seed) -> sparse (H, W) float32 metres, 0 = no sample
 
 DEFAULT_COLUMNS = (
     "rmse_m",
@@ -168,10 +168,10 @@ def open_folder(root: str | os.PathLike, split: str | None = None, *, sampler: s
       sampler: a lipjax.data.sampling spec or "input[:N]" (the folder's own sparse/<stem> maps, as depth/); by
         default "input" when the folder has sparse/, else DEFAULT_SAMPLER.
       depth_scale: PNG value per metre of the depth/ and sparse/ PNGs.
-      intrinsics: overrides the folder's (lipjax.data.sample.Intrinsics); read only by a LiDAR-simulating sampler.
+      intrinsics: overrides the folder's (lipjax.data.frame.Intrinsics); read only by a LiDAR-simulating sampler.
 
     Returns:
-      (frames: an indexable of Samples, the sampler, its spec, which frames in words: "every frame",
+      (frames: an indexable of Frames, the sampler, its spec, which frames in words: "every frame",
       "val/: every frame", "val split: the last 5 % of the frames, as lipjax train holds them out", ...).
     """
     from lipjax.data.errors import dataset_error
@@ -214,7 +214,7 @@ class EvalData:
     """Frames to evaluate on, as `open_eval_data` opens them.
 
     Attributes:
-      dataset: an indexable of Samples, the protocol applied. sampler: (sample, seed) -> sparse (H, W) metres.
+      dataset: an indexable of Frames, the protocol applied. sampler: (frame, seed) -> sparse (H, W) metres.
       spec: the sampler's spec. name: the data in words. range_from: the protocol whose depth range is evaluated,
         or None (a folder, frames as they are: the caller gives the range).
     """
@@ -310,7 +310,7 @@ def open_eval_data(data: str | None = None, source: str | None = None, *, root: 
 
 def evaluate(
     completer: DepthCompleter,
-    dataset: Sequence[Sample],
+    dataset: Sequence[Frame],
     sampler: Sampler,
     *,
     min_depth_m: float,
@@ -321,18 +321,18 @@ def evaluate(
     warmup: bool = True,
     pred_floor_m: float = DEFAULT_PRED_FLOOR_M,
 ) -> EvalResult:
-    """Completes every sample of `dataset` (the first `limit` ones if given) and scores it.
+    """Completes every frame of `dataset` (the first `limit` ones if given) and scores it.
 
     Args:
       completer: (rgb (H, W, 3) uint8, sparse (H, W) float32 m) -> (H, W) metres, with a `name`.
-      dataset: an indexable of `Sample` with len().
-      sampler: (sample, seed) -> sparse (H, W) float32 metres, 0 = no sample.
+      dataset: an indexable of `Frame` with len().
+      sampler: (frame, seed) -> sparse (H, W) float32 metres, 0 = no sample.
       min_depth_m, max_depth_m: evaluated ground-truth range (min, max] in metres; a named protocol of
         lipjax.data.protocols carries them (protocol.min_depth_m, protocol.max_depth_m).
-      limit: evaluate only the first `limit` samples.
+      limit: evaluate only the first `limit` frames.
       progress: show a progress bar on stderr.
-      seed: passed to the sampler with every sample.
-      warmup: make one untimed call on the first sample first (compilation of jitted models).
+      seed: passed to the sampler with every frame.
+      warmup: make one untimed call on the first frame first (compilation of jitted models).
       pred_floor_m: see lipjax.metrics.compute_metrics.
 
     Returns:
@@ -351,22 +351,22 @@ def evaluate(
 
         indices = tqdm(indices, desc=name, file=sys.stderr, leave=False)
     for i in indices:
-        sample = dataset[i]
-        sparse = np.asarray(sampler(sample, seed), dtype=np.float32)
+        frame = dataset[i]
+        sparse = np.asarray(sampler(frame, seed), dtype=np.float32)
         if warmup and i == 0:
-            np.asarray(completer(sample.rgb, sparse))
+            np.asarray(completer(frame.rgb, sparse))
         t0 = time.perf_counter()
-        pred = np.asarray(completer(sample.rgb, sparse))
+        pred = np.asarray(completer(frame.rgb, sparse))
         dt_ms = 1000.0 * (time.perf_counter() - t0)
-        if pred.shape != sample.depth.shape:
-            raise ValueError(f"{name}: prediction shape {pred.shape} != ground truth {sample.depth.shape} "
-                             f"({sample.id})")
+        if pred.shape != frame.depth.shape:
+            raise ValueError(f"{name}: prediction shape {pred.shape} != ground truth {frame.depth.shape} "
+                             f"({frame.id})")
         m = compute_metrics(
-            pred, sample.depth, sample.valid, sparse,
+            pred, frame.depth, frame.valid, sparse,
             min_depth_m=min_depth_m, max_depth_m=max_depth_m, pred_floor_m=pred_floor_m,
         )
         agg.add(m)
-        per_image.append({"id": sample.id, **m, "ms": dt_ms})
+        per_image.append({"id": frame.id, **m, "ms": dt_ms})
         times_ms.append(dt_ms)
     return EvalResult(
         name=name,

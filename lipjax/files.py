@@ -48,8 +48,8 @@ import numpy as np
 from lipjax import defaults
 from lipjax.data.folder import (KNOWN_DEPTH_SCALES, check_one_depth_format, output_format, pair_frames, read_frame,
                                 read_intrinsics, read_rgb, write_depth)
+from lipjax.data.frame import Intrinsics
 from lipjax.data.lidar import project_sweep, read_lidar_frame
-from lipjax.data.sample import Intrinsics
 from lipjax.classical import fill_holes
 from lipjax.defaults import CROSS_CHECK
 from lipjax.inference import Completer, FramePlan, complete_frame, frame_size, one_frame, plan_frame

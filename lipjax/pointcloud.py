@@ -2,7 +2,7 @@
 
 Camera frame (OpenCV): x right, y down, z forward (the optical axis), metres. Pixel (row v, column u) has its
 centre at image coordinates (u, v) and sees the ray through ((u - cx) / fx, (v - cy) / fy, 1); cx, cy are in
-the same pixel-index coordinates (lipjax.data.sample.Intrinsics). Depth is z, the distance along the optical
+the same pixel-index coordinates (lipjax.data.frame.Intrinsics). Depth is z, the distance along the optical
 axis (not the range along the ray), as in KITTI, NYU and TUM depth images.
 
     points = backproject(depth_m, intrinsics)                         # (N, 3) for the valid pixels
@@ -18,7 +18,7 @@ import pathlib
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.utils import written_whole
 from lipjax.zbuffer import splat_nearest
 

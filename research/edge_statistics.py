@@ -95,7 +95,7 @@ def _real(root: str):
               "Middlebury": load_middlebury(os.path.join(root, "middlebury2014_motorcycle")),
               "lingbot": load_lingbot(os.path.join(root, "lingbot_rgbd")),
               "KITTI": load_kitti(os.path.join(root, "kitti"))}
-    return {name: [(s.rgb, s.depth, s.valid) for s in samples] for name, samples in groups.items()}
+    return {name: [(s.rgb, s.depth, s.valid) for s in frames] for name, frames in groups.items()}
 
 
 def main(argv=None) -> None:

@@ -32,8 +32,8 @@ def run(model: str | None, frames: int, points: int, size: tuple[int, int]) -> d
     windowed = MixedSyntheticDataset("test", 2 * frames, *size, far_view_prob=1.0)
     linear, out = get_completer("linear"), {"closed": [], "window": []}
     for i in range(frames):
-        for name, sample in (("closed", closed[2 * i]), ("window", windowed[2 * i])):
-            out[name].append(ratio_to_linear(model, linear, sample, f"uniform:{points}", cross_check=False))
+        for name, frame in (("closed", closed[2 * i]), ("window", windowed[2 * i])):
+            out[name].append(ratio_to_linear(model, linear, frame, f"uniform:{points}", cross_check=False))
         print(f"{closed[2 * i].id}  closed {out['closed'][-1]:.3f}  window {out['window'][-1]:.3f}", flush=True)
     return out
 

@@ -81,21 +81,21 @@ def shading_image(depth: np.ndarray, valid: np.ndarray, intrinsics) -> np.ndarra
     return _grey_rgb(255 * (AMBIENT + (1 - AMBIENT) * np.clip(normal @ light, 0.0, 1.0)))
 
 
-def variant_image(sample, variant: str) -> np.ndarray:
-    """(H, W, 3) uint8: the image of one variant for `sample`."""
+def variant_image(frame, variant: str) -> np.ndarray:
+    """(H, W, 3) uint8: the image of one variant for `frame`."""
     if variant == "photograph":
-        return sample.rgb
+        return frame.rgb
     if variant == "grey":
-        return np.full_like(sample.rgb, GREY)
+        return np.full_like(frame.rgb, GREY)
     if variant == "edges":
-        return _grey_rgb(np.where(depth_edges(sample.depth, sample.valid), EDGE_GREY, BACKGROUND_GREY))
+        return _grey_rgb(np.where(depth_edges(frame.depth, frame.valid), EDGE_GREY, BACKGROUND_GREY))
     if variant == "shading":
-        return shading_image(sample.depth, sample.valid, sample.intrinsics)
+        return shading_image(frame.depth, frame.valid, frame.intrinsics)
     if variant == "both":
-        edges = depth_edges(sample.depth, sample.valid)[..., None]
-        shading = shading_image(sample.depth, sample.valid, sample.intrinsics)
+        edges = depth_edges(frame.depth, frame.valid)[..., None]
+        shading = shading_image(frame.depth, frame.valid, frame.intrinsics)
         return np.where(edges, EDGE_GREY, shading).astype(np.uint8)
-    return cv2.pyrMeanShiftFiltering(np.ascontiguousarray(sample.rgb), MEAN_SHIFT_SP, MEAN_SHIFT_SR)
+    return cv2.pyrMeanShiftFiltering(np.ascontiguousarray(frame.rgb), MEAN_SHIFT_SP, MEAN_SHIFT_SR)
 
 
 def main(argv=None) -> None:
@@ -114,12 +114,12 @@ def main(argv=None) -> None:
     renders = SyntheticDataset("indoor", "test", size=args.synthetic, height=480, width=640)
     frames += [("renders", s, UniformSampler(INDOOR_POINTS)(s, 0)) for s in renders]
     linear, rows = get_completer("linear"), []
-    for group, sample, sparse in frames:
-        ratios = ratios_to_linear(args.model, linear, sample, lambda s, _, sparse=sparse: sparse,
-                                  [variant_image(sample, v) for v in variants], cross_check=False)
-        row = {"group": group, "frame": sample.id, **dict(zip(variants, ratios))}
+    for group, frame, sparse in frames:
+        ratios = ratios_to_linear(args.model, linear, frame, lambda s, _, sparse=sparse: sparse,
+                                  [variant_image(frame, v) for v in variants], cross_check=False)
+        row = {"group": group, "frame": frame.id, **dict(zip(variants, ratios))}
         rows.append(row)
-        print(f"{sample.id:34s} " + "  ".join(f"{v} {row[v]:.3f}" for v in variants), flush=True)
+        print(f"{frame.id:34s} " + "  ".join(f"{v} {row[v]:.3f}" for v in variants), flush=True)
     others = [v for v in variants if v != "grey"]
     print("\n| frames | n | " + " | ".join(variants) + " | " + " | ".join(f"worth: {v}" for v in others) + " |")
     print("|---|---:|" + "---:|" * (len(variants) + len(others)))

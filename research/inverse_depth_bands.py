@@ -39,14 +39,14 @@ def main(argv=None) -> None:
     squared = {name: np.zeros(len(edges) - 1) for name in names}  # summed (1/km)^2 per band
     counts = np.zeros(len(edges) - 1)
     for i in range(len(dataset)):
-        sample = dataset[i]
-        sparse = sampler(sample, 0)
-        valid = sample.valid & (sample.depth > protocol.min_depth_m) & (sample.depth <= protocol.max_depth_m)
-        band = np.digitize(sample.depth[valid], edges[1:-1], right=True)
+        frame = dataset[i]
+        sparse = sampler(frame, 0)
+        valid = frame.valid & (frame.depth > protocol.min_depth_m) & (frame.depth <= protocol.max_depth_m)
+        band = np.digitize(frame.depth[valid], edges[1:-1], right=True)
         counts += np.bincount(band, minlength=len(counts))
         for name, method in methods.items():
-            pred = np.maximum(np.asarray(method(sample.rgb, sparse)).reshape(sample.depth.shape), args.floor_m)
-            error = (1000.0 / pred[valid] - 1000.0 / sample.depth[valid]) ** 2
+            pred = np.maximum(np.asarray(method(frame.rgb, sparse)).reshape(frame.depth.shape), args.floor_m)
+            error = (1000.0 / pred[valid] - 1000.0 / frame.depth[valid]) ** 2
             squared[name] += np.bincount(band, weights=error, minlength=len(counts))
     total = counts.sum()
     header = [f"{lo:g}-{hi:g} m" for lo, hi in zip(edges[:-1], edges[1:])]

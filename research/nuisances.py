@@ -51,58 +51,58 @@ SCENES = (("rooms 200 points", "indoor", (480, 640), "uniform:200"),
 WOBBLE_GRID = (12, 16)  # cells of the smooth relative depth error, rows x columns
 
 
-def shifted(sample, px: int):
+def shifted(frame, px: int):
     """The image moved px pixels right and down against the depth (edge pixels repeated)."""
-    rgb = np.pad(sample.rgb, ((px, 0), (px, 0), (0, 0)), mode="edge")[:sample.rgb.shape[0], :sample.rgb.shape[1]]
-    return with_rgb(sample, rgb)
+    rgb = np.pad(frame.rgb, ((px, 0), (px, 0), (0, 0)), mode="edge")[:frame.rgb.shape[0], :frame.rgb.shape[1]]
+    return with_rgb(frame, rgb)
 
 
-def depth_times(sample, factor: np.ndarray):
+def depth_times(frame, factor: np.ndarray):
     """Depth times a per-pixel factor on the valid pixels (the samples are drawn from this depth afterwards)."""
-    depth = np.where(sample.valid, sample.depth * factor, sample.depth).astype(np.float32)
-    return dataclasses.replace(sample, depth=depth)
+    depth = np.where(frame.valid, frame.depth * factor, frame.depth).astype(np.float32)
+    return dataclasses.replace(frame, depth=depth)
 
 
-def noisy(sample, rel: float, rng: np.random.Generator):
+def noisy(frame, rel: float, rng: np.random.Generator):
     """Depth times 1 + rel n, n ~ N(0, 1) independently per pixel."""
-    return depth_times(sample, 1.0 + rel * rng.standard_normal(sample.depth.shape))
+    return depth_times(frame, 1.0 + rel * rng.standard_normal(frame.depth.shape))
 
 
-def wobbled(sample, rel: float, rng: np.random.Generator):
+def wobbled(frame, rel: float, rng: np.random.Generator):
     """Depth times 1 + rel f, f a standard normal field on WOBBLE_GRID cells, bicubically enlarged."""
     grid = rng.standard_normal(WOBBLE_GRID).astype(np.float32)
-    field = cv2.resize(grid, sample.depth.shape[::-1], interpolation=cv2.INTER_CUBIC)
-    return depth_times(sample, 1.0 + rel * field)
+    field = cv2.resize(grid, frame.depth.shape[::-1], interpolation=cv2.INTER_CUBIC)
+    return depth_times(frame, 1.0 + rel * field)
 
 
-def with_rgb(sample, rgb: np.ndarray):
-    """The sample with another image."""
-    return dataclasses.replace(sample, rgb=np.ascontiguousarray(rgb))
+def with_rgb(frame, rgb: np.ndarray):
+    """The frame with another image."""
+    return dataclasses.replace(frame, rgb=np.ascontiguousarray(rgb))
 
 
-def edges_lost(sample):
+def edges_lost(frame):
     """No valid depth at failure_look's depth-edge pixels, so no sample and no score there."""
-    edge = pixel_classes(sample.rgb, sample.depth, sample.valid) == 0
-    return dataclasses.replace(sample, valid=sample.valid & ~edge)
+    edge = pixel_classes(frame.rgb, frame.depth, frame.valid) == 0
+    return dataclasses.replace(frame, valid=frame.valid & ~edge)
 
 
-def textured(sample, patches: int, rng: np.random.Generator):
+def textured(frame, patches: int, rng: np.random.Generator):
     """`paint_texture` at strength 0.7 on `patches` rectangles of the image."""
-    rgb = sample.rgb
+    rgb = frame.rgb
     for _ in range(patches):
         rgb = paint_texture(np.ascontiguousarray(rgb), 0.7, rng)
-    return with_rgb(sample, rgb)
+    return with_rgb(frame, rgb)
 
 
-def reflected(sample, rng: np.random.Generator):
-    """The test render `sample` drawn again with a reflecting floor (its depth, scene and noise unchanged)."""
-    _, kind, split, index = sample.id.split("/")
+def reflected(frame, rng: np.random.Generator):
+    """The test render `frame` drawn again with a reflecting floor (its depth, scene and noise unchanged)."""
+    _, kind, split, index = frame.id.split("/")
     reflection = Reflection(float(rng.uniform(0.05, 0.3)), float(rng.uniform(0.5, 2.0)))
-    again, _ = render_with_info(kind, split, int(index), *sample.depth.shape, reflection=reflection)
-    return with_rgb(sample, again.rgb)
+    again, _ = render_with_info(kind, split, int(index), *frame.depth.shape, reflection=reflection)
+    return with_rgb(frame, again.rgb)
 
 
-NUISANCES = {  # name -> (sample, rng) -> sample
+NUISANCES = {  # name -> (frame, rng) -> frame
     "none": lambda s, rng: s,
     "RGB shifted by 2 px": lambda s, rng: shifted(s, 2),
     "RGB shifted by 4 px": lambda s, rng: shifted(s, 4),

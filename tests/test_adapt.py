@@ -13,9 +13,9 @@ import pytest
 import lipjax
 from lipjax import model_io
 from lipjax.data.augment import Augment
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.hidden import AtWorkingSize, hidden_samples, hide_share, scan_line_segments, working_shape
 from lipjax.data.pipeline import BatchIterator, StepBatches, validation_batches
-from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import example_rng
 from lipjax.data.sources import open_source
 from lipjax.inputs import is_lidar_pattern
@@ -118,15 +118,15 @@ def test_frames_adapt_at_the_default_paths_working_size(tmp_path):
     sample once the samples meet on the smaller grid."""
     sparse = _scattered(1, (96, 128), 20)
     assert working_shape(sparse) == (64, 85)
-    sample = AtWorkingSize()(Sample.from_depth(np.zeros((96, 128, 3), np.uint8), sparse, Intrinsics(1, 1, 0, 0), "x"))
-    assert sample.shape == (64, 85) and sample.valid.sum() == 20
+    frame = AtWorkingSize()(Frame.from_depth(np.zeros((96, 128, 3), np.uint8), sparse, Intrinsics(1, 1, 0, 0), "x"))
+    assert frame.shape == (64, 85) and frame.valid.sum() == 20
     root = tmp_path / "big"
     _write_folder(root, range(3), size=(96, 128), n=20)
     source = open_source(DataConfig(source="folder", root=str(root), depth_scale=1000.0, train_sampler="hide:0.3",
                                     val_sampler="hide:0.3"), "train")
-    sample, inputs = BatchIterator(source.dataset, 1, source.sampler).example(0, epoch=0)
-    assert sample.shape == inputs.shape == (64, 85)
-    assert sample.valid.any() and not np.any(sample.valid & (inputs > 0))
+    frame, inputs = BatchIterator(source.dataset, 1, source.sampler).example(0, epoch=0)
+    assert frame.shape == inputs.shape == (64, 85)
+    assert frame.valid.any() and not np.any(frame.valid & (inputs > 0))
 
 
 def test_adapting_a_folder_without_depth_writes_the_model_only_when_it_beats_its_start(tmp_path, capsys,

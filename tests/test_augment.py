@@ -15,7 +15,7 @@ from lipjax.data.augment import (
     photometric,
     relight,
 )
-from lipjax.data.sample import Batch
+from lipjax.data.frame import Batch
 
 
 def _batch(n=4, h=40, w=48, seed=0):

@@ -44,12 +44,12 @@ def test_clutter_adds_things_on_the_floor_inside_the_room_in_view_and_keeps_the_
 
 
 def test_a_cluttered_room_shows_its_things_and_nothing_else_of_the_room_moves():
-    sample, info = S.render_with_info("indoor", "train", 3, H, W)
+    frame, info = S.render_with_info("indoor", "train", 3, H, W)
     cluttered, cinfo = S.render_with_info("indoor", "train", 3, H, W, clutter=clutter_rng("train", 3))
     assert (cinfo.labels == OBJECT).mean() > (info.labels == OBJECT).mean() + 0.02
-    changed = cluttered.depth != sample.depth
+    changed = cluttered.depth != frame.depth
     assert changed.any() and np.all(cinfo.labels[changed] == OBJECT)  # only the things are new
-    assert np.all(cluttered.depth[changed] < sample.depth[changed])  # in front of what they hide
+    assert np.all(cluttered.depth[changed] < frame.depth[changed])  # in front of what they hide
     np.testing.assert_array_equal(cinfo.camera_to_world, info.camera_to_world)
     with pytest.raises(ValueError, match="clutter is for rooms"):
         S.render_with_info("outdoor", "train", 3, H, W, clutter=clutter_rng("train", 3))

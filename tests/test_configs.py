@@ -119,10 +119,10 @@ def test_the_shipped_default_model_beats_the_linear_fill_on_rendered_rooms_and_s
     model = lipjax.load_model(DEFAULT_MODEL)
     ratios = []
     for kind, h, w, spec, n in (("indoor", 128, 160, "uniform:100", 3), ("outdoor", 128, 416, "lidar:hdl64", 2)):
-        for sample in SyntheticDataset(kind, "test", size=n, height=h, width=w):
-            sparse = sampler_from_spec(spec)(sample, 0)
-            keep = sample.valid & (sparse <= 0)
-            rmse = [np.sqrt(np.mean((pred[keep] - sample.depth[keep]) ** 2))
-                    for pred in (lipjax.complete(sample.rgb, sparse, model=model), linear_fill(sparse))]
+        for frame in SyntheticDataset(kind, "test", size=n, height=h, width=w):
+            sparse = sampler_from_spec(spec)(frame, 0)
+            keep = frame.valid & (sparse <= 0)
+            rmse = [np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2))
+                    for pred in (lipjax.complete(frame.rgb, sparse, model=model), linear_fill(sparse))]
             ratios.append(rmse[0] / rmse[1])
     assert np.exp(np.mean(np.log(ratios))) < 0.95, ratios

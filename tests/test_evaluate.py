@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lipjax.classical import NearestFill
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.evaluate import EvalResult, evaluate, markdown_table, save_json
 from lipjax.metrics import compute_metrics
 
@@ -19,16 +19,16 @@ def _dataset(n=3):
         depth = (1.0 + i + 0.1 * xx + 0.05 * yy).astype(np.float32)
         depth[0, :3] = 0  # a few invalid pixels
         rgb = np.full((H, W, 3), 40 * i, np.uint8)
-        out.append(Sample.from_depth(rgb, depth, Intrinsics(10.0, 10.0, W / 2, H / 2), f"toy/{i}"))
+        out.append(Frame.from_depth(rgb, depth, Intrinsics(10.0, 10.0, W / 2, H / 2), f"toy/{i}"))
     return out
 
 
-def _sampler(sample: Sample, seed: int) -> np.ndarray:
-    """Exactly 6 valid pixels, drawn from a key derived from the sample id and the seed."""
-    rng = np.random.default_rng([seed, int(sample.id.split("/")[1])])
-    idx = rng.choice(np.flatnonzero(sample.valid), 6, replace=False)
-    sparse = np.zeros(sample.shape, np.float32)
-    sparse.flat[idx] = sample.depth.flat[idx]
+def _sampler(frame: Frame, seed: int) -> np.ndarray:
+    """Exactly 6 valid pixels, drawn from a key derived from the frame id and the seed."""
+    rng = np.random.default_rng([seed, int(frame.id.split("/")[1])])
+    idx = rng.choice(np.flatnonzero(frame.valid), 6, replace=False)
+    sparse = np.zeros(frame.shape, np.float32)
+    sparse.flat[idx] = frame.depth.flat[idx]
     return sparse
 
 
@@ -168,10 +168,10 @@ def test_working_size_scores_the_default_path_not_the_model_at_the_input_size():
     default = report.results["untrained"]
     assert report.header().endswith("m, models at the samples' working size (as lipjax complete)")
     assert (default.size, plain.size) == ("working", "input")
-    sample = SyntheticDataset("indoor", "test", size=1, height=160, width=200)[0]
-    sparse = sampler_from_spec("uniform:20")(sample, 0)
+    frame = SyntheticDataset("indoor", "test", size=1, height=160, width=200)[0]
+    sparse = sampler_from_spec("uniform:20")(frame, 0)
     assert frame_size(model, sparse) == (64, 80)
-    expected = compute_metrics(complete_frame(model, sample.rgb, sparse), sample.depth, sample.valid, sparse,
+    expected = compute_metrics(complete_frame(model, frame.rgb, sparse), frame.depth, frame.valid, sparse,
                                max_depth_m=10.0)
     assert default.per_image[0]["rmse_m"] == pytest.approx(expected["rmse_m"], rel=1e-6)
     assert default.metrics["mae_sampled_m"] == 0.0

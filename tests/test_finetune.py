@@ -13,8 +13,8 @@ import pytest
 import lipjax
 from lipjax import model_io
 from lipjax.data.augment import Augment, augment_batch
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.pipeline import BatchIterator, StepBatches, stacked, validation_batches
-from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import UniformSampler, draws_scan_lines, sampler_from_spec
 from lipjax.data.sources import Source
 from lipjax.model import LIPConfig
@@ -48,16 +48,16 @@ def _write_frames(folder, seeds) -> None:
             assert cv2.imwrite(str(folder / d / f"{i:04d}.png"), np.rint(metres * 1000).astype(np.uint16))
 
 
-def _samples(n: int) -> list[Sample]:
-    return [Sample.from_depth(*_frame(i, SIZES[i % 2])[:2], Intrinsics(30, 30, 20, 15), f"mixed/{i}")
+def _frames(n: int) -> list[Frame]:
+    return [Frame.from_depth(*_frame(i, SIZES[i % 2])[:2], Intrinsics(30, 30, 20, 15), f"mixed/{i}")
             for i in range(n)]
 
 
 def test_frames_of_mixed_sizes_are_cropped_one_by_one_and_validated_each_at_its_own_size():
     """A training step of frames of two sizes: each frame is cropped before batching, with the draws it has in a
     batch of one size; validation batches frames of one size together, each whole."""
-    samples, aug = _samples(5), Augment(zoom=(0.8, 1.25), hflip=True)
-    iterator = BatchIterator(samples, 4, UniformSampler(20), seed=3)
+    frames, aug = _frames(5), Augment(zoom=(0.8, 1.25), hflip=True)
+    iterator = BatchIterator(frames, 4, UniformSampler(20), seed=3)
     steps = StepBatches(iterator, 2, aug, CROP, seed=3, model_config=None)
     got = steps[1]
     assert got["rgb"].shape == (4, *CROP, 3) and got["gt"].shape == got["sparse"].shape == (4, *CROP)
@@ -66,9 +66,9 @@ def test_frames_of_mixed_sizes_are_cropped_one_by_one_and_validated_each_at_its_
         assert np.array_equal(got["gt"][i], alone.gt[0]) and np.array_equal(got["rgb"][i], alone.rgb[0])
     with pytest.raises(ValueError, match=r"different sizes .*; train with a crop \(data.crop"):
         StepBatches(iterator, 2, aug, None, seed=3, model_config=None)[1]
-    batches = validation_batches(Source(samples, UniformSampler(20)), None, batch_size=2)
+    batches = validation_batches(Source(frames, UniformSampler(20)), None, batch_size=2)
     assert [b.gt.shape for b in batches] == [(1, *SIZES[0]), (1, *SIZES[1])] * 2 + [(1, *SIZES[0])]
-    same = validation_batches(Source(samples[::2], UniformSampler(20)), None, batch_size=2)
+    same = validation_batches(Source(frames[::2], UniformSampler(20)), None, batch_size=2)
     assert [b.gt.shape[0] for b in same] == [2, 1]
 
 

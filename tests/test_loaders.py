@@ -17,9 +17,9 @@ from lipjax.data.kitti import (
     KittiSelection,
     intrinsics_from_calib,
 )
+from lipjax.data.frame import Intrinsics
 from lipjax.data.nyu import NYU_INTRINSICS, NyuH5Dataset, NyuTfdsDataset
 from lipjax.data.protocols import BottomCrop, EvalProtocol
-from lipjax.data.sample import Intrinsics
 from lipjax.data.tartanair import TARTANAIR_INTRINSICS, TARTANAIR_MAX_VALID_DEPTH_M, TartanAirDataset
 
 H, W = 12, 16
@@ -316,9 +316,9 @@ def test_kitti_odometry_projects_the_scan_into_image_2(tmp_path):
     points = np.array([[4.0, 0.5, 0.0, 0.3], [8.0, 0.5, 0.0, 0.1], [-3.0, 0.0, 0.0, 0.2]], np.float32)
     points.tofile(seq / "velodyne" / "000000.bin")
     ds = KittiOdometry(tmp_path)
-    sample = ds[0]
-    assert len(ds) == 1 and sample.id == "kitti_odometry/00/000000"
-    assert sample.depth[5, 6] == pytest.approx(4.0)  # the nearer of the two points on that ray wins; behind dropped
-    assert sample.valid.sum() == 1
+    frame = ds[0]
+    assert len(ds) == 1 and frame.id == "kitti_odometry/00/000000"
+    assert frame.depth[5, 6] == pytest.approx(4.0)  # the nearer of the two points on that ray wins; behind dropped
+    assert frame.valid.sum() == 1
     with pytest.raises(ValueError, match="KITTI odometry root not found"):
         KittiOdometry(tmp_path / "nope")

@@ -10,23 +10,23 @@ import numpy as np
 import pytest
 
 from lipjax.data.augment import Augment
+from lipjax.data.frame import Batch, Frame, Intrinsics
 from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader
 from lipjax.data.protocols import EvalProtocol, Resize
-from lipjax.data.sample import Batch, Intrinsics, Sample
 from lipjax.data.sampling import UniformSampler
 
 H, W = 6, 8
 
 
-def fake_dataset(n: int = 10) -> list[Sample]:
-    """Sample i has depth i + 1 everywhere (minus a few holes), so batches reveal which examples they hold."""
+def fake_dataset(n: int = 10) -> list[Frame]:
+    """Frame i has depth i + 1 everywhere (minus a few holes), so batches reveal which examples they hold."""
     out = []
     for i in range(n):
         rng = np.random.default_rng(i)
         depth = np.full((H, W), i + 1.0, np.float32)
         depth[rng.random((H, W)) < 0.2] = 0
         rgb = rng.integers(0, 256, (H, W, 3), dtype=np.uint8)
-        out.append(Sample.from_depth(rgb, depth, Intrinsics(10, 10, W / 2, H / 2), f"fake/{i:03d}"))
+        out.append(Frame.from_depth(rgb, depth, Intrinsics(10, 10, W / 2, H / 2), f"fake/{i:03d}"))
     return out
 
 
@@ -91,7 +91,7 @@ def test_protocol_and_sparse_seed():
     a, b = make(sample_seed=0).batch(0), make(sample_seed=1).batch(0)
     assert np.array_equal(a.gt, b.gt) and not np.array_equal(a.sparse, b.sparse)
     with pytest.raises(ValueError, match="different sizes"):
-        make(fake_dataset(2) + [Sample.from_depth(np.zeros((2, 2, 3), np.uint8), np.ones((2, 2), np.float32),
+        make(fake_dataset(2) + [Frame.from_depth(np.zeros((2, 2, 3), np.uint8), np.ones((2, 2), np.float32),
                                                      Intrinsics(1, 1, 1, 1), "odd")], shuffle=False).batch(0)
 
 
@@ -172,11 +172,11 @@ def test_shard_batch_single_device():
 
 MULTI_DEVICE_SCRIPT = r"""
 import numpy as np, jax
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.pipeline import BatchIterator, make_data_mesh, shard_batch
-from lipjax.data.sample import Intrinsics, Sample
 from lipjax.data.sampling import UniformSampler
 assert jax.device_count() == 4, jax.devices()
-data = [Sample.from_depth(np.full((4, 5, 3), i, np.uint8), np.full((4, 5), i + 1.0, np.float32),
+data = [Frame.from_depth(np.full((4, 5, 3), i, np.uint8), np.full((4, 5), i + 1.0, np.float32),
                           Intrinsics(5, 5, 2, 2), f"d/{i}") for i in range(16)]
 it = BatchIterator(data, 8, UniformSampler(3), seed=0)
 batch = it.batch(1)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.pointcloud import ProjectionCounts, backproject, backproject_rgbd, project_lidar_to_depth, write_ply
 
 H, W = 24, 32

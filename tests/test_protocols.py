@@ -18,23 +18,23 @@ from lipjax.data.protocols import (
     nearest_indices,
     tartanair_split,
 )
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.metrics import evaluation_mask
 
 K_NYU = Intrinsics(518.8579, 519.46961, 325.58245, 253.73617)
 K_KITTI = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
 
 
-def index_sample(h: int, w: int, k: Intrinsics, holes: bool = False) -> Sample:
+def index_frame(h: int, w: int, k: Intrinsics, holes: bool = False) -> Frame:
     """Depth = 1 + flat pixel index (exact in float32), so every output pixel names its source pixel."""
     depth = (1 + np.arange(h * w, dtype=np.float64)).reshape(h, w).astype(np.float32)
     if holes:
         depth[np.random.default_rng(0).random((h, w)) < 0.4] = 0
     rgb = np.random.default_rng(1).integers(0, 256, (h, w, 3), dtype=np.uint8)
-    return Sample.from_depth(rgb, depth, k, "test/index")
+    return Frame.from_depth(rgb, depth, k, "test/index")
 
 
-def source_pixels(out: Sample, w_in: int) -> tuple[np.ndarray, np.ndarray]:
+def source_pixels(out: Frame, w_in: int) -> tuple[np.ndarray, np.ndarray]:
     flat = out.depth.astype(np.int64) - 1
     return np.divmod(flat, w_in)
 
@@ -53,7 +53,7 @@ def test_registry_names_and_sizes():
     for name, (in_size, out_size) in expected.items():
         p = get_protocol(name)
         assert p.name == name and p.output_size == out_size
-        out = p(index_sample(*in_size, K_NYU))
+        out = p(index_frame(*in_size, K_NYU))
         assert out.shape == out_size and out.rgb.shape == (*out_size, 3) and out.id == "test/index"
     with pytest.raises(KeyError, match="known"):
         get_protocol("nope")
@@ -70,7 +70,7 @@ def test_depth_ranges():
 
 
 def test_nyu_paper_exact_window_and_intrinsics():
-    out = PROTOCOLS["nyu_paper"](index_sample(480, 640, K_NYU))
+    out = PROTOCOLS["nyu_paper"](index_frame(480, 640, K_NYU))
     rows, cols = source_pixels(out, 640)
     # Centre crop 464x580 (rows 8.., cols 30..) then nearest with scale 464/256 = 580/320.
     s = 464 / 256
@@ -88,7 +88,7 @@ def test_nyu_paper_exact_window_and_intrinsics():
                                              ("kitti_paper", (375, 1242), K_KITTI)])
 def test_nearest_depth_is_consistent_with_intrinsics(name, in_size, k):
     """The source pixel of each output pixel lies on (almost) the same camera ray as the output pixel."""
-    out = PROTOCOLS[name](index_sample(*in_size, k))
+    out = PROTOCOLS[name](index_frame(*in_size, k))
     rows, cols = source_pixels(out, in_size[1])
     v, u = np.mgrid[0 : out.shape[0], 0 : out.shape[1]]
     ko = out.intrinsics
@@ -100,7 +100,7 @@ def test_nearest_depth_is_consistent_with_intrinsics(name, in_size, k):
 
 
 def test_nyu_ma_offsets():
-    out = PROTOCOLS["nyu_ma"](index_sample(480, 640, K_NYU))
+    out = PROTOCOLS["nyu_ma"](index_frame(480, 640, K_NYU))
     rows, cols = source_pixels(out, 640)
     # Resize x0.5 (output i samples 2i + 1), then crop rows 6.., cols 8..
     assert rows[0, 0] == 2 * 6 + 1 and cols[0, 0] == 2 * 8 + 1
@@ -110,54 +110,54 @@ def test_nyu_ma_offsets():
 
 @pytest.mark.parametrize("in_size,top,left", [((375, 1242), 119, 13), ((370, 1226), 114, 5), ((376, 1241), 120, 12)])
 def test_kitti_paper_bottom_crop(in_size, top, left):
-    sample = index_sample(*in_size, K_KITTI)
-    out = PROTOCOLS["kitti_paper"](sample)
-    assert np.array_equal(out.depth, sample.depth[top:, left : left + 1216])
-    assert np.array_equal(out.rgb, sample.rgb[top:, left : left + 1216])
+    frame = index_frame(*in_size, K_KITTI)
+    out = PROTOCOLS["kitti_paper"](frame)
+    assert np.array_equal(out.depth, frame.depth[top:, left : left + 1216])
+    assert np.array_equal(out.rgb, frame.rgb[top:, left : left + 1216])
     assert out.intrinsics == Intrinsics(K_KITTI.fx, K_KITTI.fy, K_KITTI.cx - left, K_KITTI.cy - top)
 
 
 def test_kitti_selection_is_identity_on_selection_frames_and_crops_full_frames():
-    sel = index_sample(352, 1216, K_KITTI)
+    sel = index_frame(352, 1216, K_KITTI)
     assert np.array_equal(PROTOCOLS["kitti_selection"](sel).depth, sel.depth)
-    full = index_sample(375, 1242, K_KITTI)
+    full = index_frame(375, 1242, K_KITTI)
     assert np.array_equal(PROTOCOLS["kitti_selection"](full).depth, full.depth[23:, 13:1229])
 
 
 def test_no_mixing_of_valid_and_invalid():
-    sample = index_sample(480, 640, K_NYU, holes=True)
+    frame = index_frame(480, 640, K_NYU, holes=True)
     for name in ("nyu_paper", "nyu_ma", "tartanair"):
-        out = PROTOCOLS[name](sample)
+        out = PROTOCOLS[name](frame)
         assert np.array_equal(out.valid, out.depth > 0)
-        assert np.all(np.isin(out.depth[out.valid], sample.depth[sample.valid]))  # every value is a real pixel
+        assert np.all(np.isin(out.depth[out.valid], frame.depth[frame.valid]))  # every value is a real pixel
 
 
 def test_rgb_uses_area_interpolation_when_shrinking():
     rgb = np.zeros((480, 640, 3), np.uint8)
     rgb[:, 1::2] = 200  # alternate columns: area averages to 100, nearest would give 0 or 200
-    sample = Sample.from_depth(rgb, np.ones((480, 640), np.float32), K_NYU, "x")
-    out = PROTOCOLS["nyu_ma"](sample)
+    frame = Frame.from_depth(rgb, np.ones((480, 640), np.float32), K_NYU, "x")
+    out = PROTOCOLS["nyu_ma"](frame)
     assert np.all(np.abs(out.rgb.astype(int) - 100) <= 1)
 
 
-def test_apply_to_depth_matches_sample_geometry():
-    sample = index_sample(375, 1242, K_KITTI, holes=True)
+def test_apply_to_depth_matches_frame_geometry():
+    frame = index_frame(375, 1242, K_KITTI, holes=True)
     for name in ("kitti_paper", "nyu_ma"):
         p = PROTOCOLS[name]
         if name == "nyu_ma":
-            sample = index_sample(480, 640, K_NYU, holes=True)
-        assert np.array_equal(p.apply_to_depth(sample.depth), p(sample).depth)
-    assert get_protocol("nyu_ma")(sample).shape == (228, 304)
+            frame = index_frame(480, 640, K_NYU, holes=True)
+        assert np.array_equal(p.apply_to_depth(frame.depth), p(frame).depth)
+    assert get_protocol("nyu_ma")(frame).shape == (228, 304)
 
 
 def test_steps_errors_and_nearest_indices():
     with pytest.raises(ValueError, match="at least"):
-        CenterCrop(500, 640).apply(index_sample(480, 640, K_NYU))
+        CenterCrop(500, 640).apply(index_frame(480, 640, K_NYU))
     with pytest.raises(ValueError, match="expected"):
-        EvalProtocol("bad", (BottomCrop(10, 10),), (20, 20), 0, 1)(index_sample(30, 30, K_NYU))
+        EvalProtocol("bad", (BottomCrop(10, 10),), (20, 20), 0, 1)(index_frame(30, 30, K_NYU))
     assert nearest_indices(4, 2).tolist() == [1, 3]
     assert nearest_indices(3, 6).tolist() == [0, 0, 1, 1, 2, 2]
-    assert Resize(5, 5).apply(index_sample(5, 5, K_NYU)).intrinsics == K_NYU
+    assert Resize(5, 5).apply(index_frame(5, 5, K_NYU)).intrinsics == K_NYU
 
 
 def test_tartanair_split_by_trajectory():

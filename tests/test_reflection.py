@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lipjax.data import synthetic as S
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.data.synthetic.constants import _ROAD, _WALL
 from lipjax.data.synthetic.materials import _Mat
 from lipjax.data.synthetic.primitives import _Box, _Ground
@@ -68,13 +68,13 @@ def test_the_mirror_image_lies_where_the_reflected_ray_meets_the_wall_weighted_b
 
 @pytest.mark.parametrize("kind", S.SYNTHETIC_KINDS)
 def test_reflections_change_the_floor_only_never_the_depth(kind):
-    sample, info = S.render_with_info(kind, "val", 4, 48, 64)
+    frame, info = S.render_with_info(kind, "val", 4, 48, 64)
     shiny, shiny_info = S.render_with_info(kind, "val", 4, 48, 64, reflection=Reflection(0.3, 1.0))
-    np.testing.assert_array_equal(shiny.depth, sample.depth)
+    np.testing.assert_array_equal(shiny.depth, frame.depth)
     np.testing.assert_array_equal(shiny_info.labels, info.labels)
     scene_rng, noise_rng = S.frame_rngs(kind, "val", 4)
     matte = render_scene(S.build_scene(kind, scene_rng), 48, 64, S.intrinsics_for(kind, 48, 64), noise_rng)[0]
-    np.testing.assert_array_equal(matte, sample.rgb)  # off: the frame as every data set renders it
+    np.testing.assert_array_equal(matte, frame.rgb)  # off: the frame as every data set renders it
     scene = S.build_scene(kind, S.frame_rngs(kind, "val", 4)[0])
     intr = S.intrinsics_for(kind, 48, 64)
     (matte_lin, labels), (shiny_lin, _) = (_radiance(scene, r, intr, (48, 64)) for r in (None, Reflection(0.3, 1.0)))

@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lipjax.data import parallax
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.sampling import (
     BernoulliSampler,
     HolesSampler,
@@ -31,20 +31,20 @@ K_KITTI = Intrinsics(721.5377, 721.5377, 609.5593, 172.854)
 CAMERA_HEIGHT_M = 1.65
 
 
-def random_sample(id: str = "a", h: int = 60, w: int = 80, hole_fraction: float = 0.3) -> Sample:
+def random_frame(id: str = "a", h: int = 60, w: int = 80, hole_fraction: float = 0.3) -> Frame:
     rng = np.random.default_rng(0)  # same pixels for every id: only the id changes
     depth = rng.uniform(0.5, 10.0, (h, w)).astype(np.float32)
     depth[rng.random((h, w)) < hole_fraction] = 0
-    return Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), id)
+    return Frame.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), id)
 
 
-def plane_scene(wall_m: float = 60.0, h: int = 375, w: int = 1242) -> Sample:
+def plane_scene(wall_m: float = 60.0, h: int = 375, w: int = 1242) -> Frame:
     """KITTI-like camera 1.65 m above a flat ground, looking level; a wall at wall_m fills the top."""
     v = np.arange(h, dtype=np.float64)[:, None] * np.ones((1, w))
     with np.errstate(divide="ignore"):
         ground = np.where(v > K_KITTI.cy + 0.5, CAMERA_HEIGHT_M * K_KITTI.fy / (v - K_KITTI.cy), np.inf)
     depth = np.minimum(ground, wall_m).astype(np.float32)
-    return Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, K_KITTI, "plane")
+    return Frame.from_depth(np.zeros((h, w, 3), np.uint8), depth, K_KITTI, "plane")
 
 
 def count_scan_lines(sparse: np.ndarray, half_width: int = 20) -> int:
@@ -66,21 +66,21 @@ def beams_in_view(sampler: LidarSampler, h: int = 375) -> int:
 
 
 def test_uniform_exact_count_valid_pixels_and_values():
-    sample = random_sample()
-    sparse = UniformSampler(200)(sample)
-    assert sparse.dtype == np.float32 and sparse.shape == sample.shape
+    frame = random_frame()
+    sparse = UniformSampler(200)(frame)
+    assert sparse.dtype == np.float32 and sparse.shape == frame.shape
     assert np.count_nonzero(sparse) == 200
-    assert np.all(sample.valid[sparse > 0]) and np.array_equal(sparse[sparse > 0], sample.depth[sparse > 0])
+    assert np.all(frame.valid[sparse > 0]) and np.array_equal(sparse[sparse > 0], frame.depth[sparse > 0])
 
 
 def test_uniform_fewer_valid_than_requested_keeps_all():
-    sample = random_sample(h=10, w=10, hole_fraction=0.5)
-    sparse = UniformSampler(500)(sample)
-    assert np.array_equal(sparse > 0, sample.valid)
+    frame = random_frame(h=10, w=10, hole_fraction=0.5)
+    sparse = UniformSampler(500)(frame)
+    assert np.array_equal(sparse > 0, frame.valid)
 
 
 def test_uniform_deterministic_per_id_and_seed():
-    a, b = random_sample("a"), random_sample("b")  # same pixels, different ids
+    a, b = random_frame("a"), random_frame("b")  # same pixels, different ids
     s = UniformSampler(100)
     assert np.array_equal(s(a), s(a)) and np.array_equal(s(a, seed=3), s(a, seed=3))
     assert not np.array_equal(s(a) > 0, s(b) > 0)
@@ -91,16 +91,16 @@ def test_uniform_independent_of_process_and_hash_seed():
     """The points depend on sha256(seed/id) only: another interpreter with another hash seed agrees."""
     code = (
         "import json, numpy as np\n"
-        "from lipjax.data.sample import Sample, Intrinsics\n"
+        "from lipjax.data.frame import Frame, Intrinsics\n"
         "from lipjax.data.sampling import UniformSampler\n"
-        "s = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), "
+        "s = Frame.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), "
         "Intrinsics(1,1,0,0), 'nyu/val/x/1')\n"
         "print(json.dumps(np.flatnonzero(UniformSampler(25)(s, seed=7)).tolist()))\n"
     )
     env = {**os.environ, "PYTHONHASHSEED": "12345"}
     result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
-    here = Sample.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1, 1, 0, 0),
-                             "nyu/val/x/1")
+    here = Frame.from_depth(np.zeros((30, 40, 3), np.uint8), np.ones((30, 40), np.float32), Intrinsics(1, 1, 0, 0),
+                            "nyu/val/x/1")
     assert json.loads(result.stdout) == np.flatnonzero(UniformSampler(25)(here, seed=7)).tolist()
 
 
@@ -110,13 +110,13 @@ def test_example_rng_streams_differ():
 
 
 def test_bernoulli_count_on_average_and_valid_only():
-    sample = random_sample(h=200, w=300)
-    n_valid = int(sample.valid.sum())
-    counts = [np.count_nonzero(BernoulliSampler(500)(sample, seed=s)) for s in range(5)]
+    frame = random_frame(h=200, w=300)
+    n_valid = int(frame.valid.sum())
+    counts = [np.count_nonzero(BernoulliSampler(500)(frame, seed=s)) for s in range(5)]
     sd = np.sqrt(500 * (1 - 500 / n_valid))
     assert all(abs(c - 500) < 5 * sd for c in counts) and len(set(counts)) > 1
-    sparse = BernoulliSampler(500)(sample)
-    assert np.all(sample.valid[sparse > 0]) and np.array_equal(sparse, BernoulliSampler(500)(sample))
+    sparse = BernoulliSampler(500)(frame)
+    assert np.all(frame.valid[sparse > 0]) and np.array_equal(sparse, BernoulliSampler(500)(frame))
 
 
 # ---- LiDAR -----------------------------------------------------------------------------------------------------
@@ -174,33 +174,33 @@ def test_lidar_dropout_is_deterministic():
 
 
 def test_noise_statistics_support_and_determinism():
-    sample = random_sample(h=200, w=300)
-    clean = UniformSampler(5000)(sample)
-    noisy = Noise(std_m=0.1)(clean, sample, seed=0)
+    frame = random_frame(h=200, w=300)
+    clean = UniformSampler(5000)(frame)
+    noisy = Noise(std_m=0.1)(clean, frame, seed=0)
     support = clean > 0
     assert np.array_equal(noisy > 0, support)
     assert np.std(noisy[support] - clean[support]) == pytest.approx(0.1, rel=0.05)
-    assert np.array_equal(noisy, Noise(std_m=0.1)(clean, sample, seed=0))
-    rel = Noise(relative_std=0.05)(clean, sample)
+    assert np.array_equal(noisy, Noise(std_m=0.1)(clean, frame, seed=0))
+    rel = Noise(relative_std=0.05)(clean, frame)
     ratio = (rel[support] - clean[support]) / clean[support]
     assert np.std(ratio) == pytest.approx(0.05, rel=0.05)
 
 
 def test_noise_outliers_exact_fraction_and_positive():
-    sample = random_sample(h=100, w=100)
-    clean = UniformSampler(1000)(sample)
-    noisy = Noise(outlier_fraction=0.1, outlier_range_m=(20.0, 30.0))(clean, sample)
+    frame = random_frame(h=100, w=100)
+    clean = UniformSampler(1000)(frame)
+    noisy = Noise(outlier_fraction=0.1, outlier_range_m=(20.0, 30.0))(clean, frame)
     changed = noisy != clean
     assert changed.sum() == 100 and np.all((noisy[changed] >= 20) & (noisy[changed] <= 30))
-    huge = Noise(std_m=50.0)(clean, sample)
+    huge = Noise(std_m=50.0)(clean, frame)
     assert np.array_equal(huge > 0, clean > 0) and huge[clean > 0].min() >= 1e-3
 
 
 def test_noisy_wrapper():
-    sample = random_sample()
+    frame = random_frame()
     s = Noisy(UniformSampler(50), Noise(std_m=0.2))
-    out = s(sample, seed=4)
-    assert np.array_equal(out > 0, UniformSampler(50)(sample, seed=4) > 0) and np.array_equal(out, s(sample, seed=4))
+    out = s(frame, seed=4)
+    assert np.array_equal(out > 0, UniformSampler(50)(frame, seed=4) > 0) and np.array_equal(out, s(frame, seed=4))
 
 
 # ---- spec parser -----------------------------------------------------------------------------------------------
@@ -228,22 +228,22 @@ def test_sampler_from_spec():
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 300), st.floats(0.0, 1.0), st.integers(0, 2**31 - 1))
 def test_uniform_count_is_min_of_n_and_valid(n, hole_fraction, seed):
-    sample = random_sample(h=12, w=15, hole_fraction=hole_fraction)
-    sparse = UniformSampler(n)(sample, seed=seed)
-    assert np.count_nonzero(sparse) == min(n, int(sample.valid.sum()))
-    assert np.all(sample.valid[sparse > 0])
+    frame = random_frame(h=12, w=15, hole_fraction=hole_fraction)
+    sparse = UniformSampler(n)(frame, seed=seed)
+    assert np.count_nonzero(sparse) == min(n, int(frame.valid.sum()))
+    assert np.all(frame.valid[sparse > 0])
 
 
 # ---- keypoints / holes ---------------------------------------------------------------------------------------
 
 
-def _half_textured(h: int = 64, w: int = 96) -> Sample:
+def _half_textured(h: int = 64, w: int = 96) -> Frame:
     """A checkerboard of 8 px squares on the left half of the image, plain grey on the right; depth 2-5 m."""
     rgb = np.full((h, w, 3), 128, np.uint8)
     yy, xx = np.mgrid[0:h, 0 : w // 2]
     rgb[:, : w // 2] = np.where(((yy // 8 + xx // 8) % 2 == 0)[..., None], 30, 220)
     depth = np.linspace(2.0, 5.0, w, dtype=np.float32)[None].repeat(h, 0)
-    return Sample.from_depth(rgb, depth, Intrinsics(80, 80, w / 2, h / 2), "half")
+    return Frame.from_depth(rgb, depth, Intrinsics(80, 80, w / 2, h / 2), "half")
 
 
 def test_keypoints_lie_on_corners_of_valid_pixels_with_their_depth():
@@ -257,9 +257,9 @@ def test_keypoints_lie_on_corners_of_valid_pixels_with_their_depth():
     inner = {(r, c) for r in range(8, 64, 8) for c in range(8, 48, 8)}  # where four squares meet: 7 x 5
     assert inner <= set(zip(rows.tolist(), cols.tolist()))
     np.testing.assert_array_equal(out, KeypointSampler(40)(s, 0))
-    holed = Sample.from_depth(s.rgb, np.where(np.arange(96)[None] < 24, 0, s.depth), s.intrinsics, "half")
+    holed = Frame.from_depth(s.rgb, np.where(np.arange(96)[None] < 24, 0, s.depth), s.intrinsics, "half")
     assert not KeypointSampler(40)(holed, 0)[:, :24].any()
-    plain = Sample.from_depth(np.full_like(s.rgb, 128), s.depth, s.intrinsics, "plain")
+    plain = Frame.from_depth(np.full_like(s.rgb, 128), s.depth, s.intrinsics, "plain")
     assert not KeypointSampler(40)(plain, 0).any()
 
 
@@ -268,7 +268,7 @@ def test_holes_keep_the_depth_but_not_occlusion_edges_and_cover_the_fraction():
     ground-truth depth, and the blobs take `fraction` of the frame (a quantile of the field); 0: only the edge."""
     h, w = 80, 100
     depth = np.where(np.arange(w)[None] < 50, 2.0, 6.0).astype(np.float32).repeat(h, 0)
-    s = Sample.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), "step")
+    s = Frame.from_depth(np.zeros((h, w, 3), np.uint8), depth, Intrinsics(80, 80, w / 2, h / 2), "step")
     only_edges = HolesSampler(0.0)(s, 0)
     assert not only_edges[:, 49:51].any() and (only_edges[:, :49] == 2.0).all() and (only_edges[:, 51:] == 6.0).all()
     for fraction in (0.2, 0.5):
@@ -325,8 +325,8 @@ def test_sensor_shadow_and_zero_baseline():
     assert not dense[15:31, 14:20].any() and dense[15:31, 12:14].all() and not dense[:, :2].any()
     seen = dense > 0
     assert np.array_equal(dense[seen], depth[seen]) and seen.sum() == 48 * 62 - 16 * 6
-    sample = Sample.from_depth(np.zeros((48, 64, 3), np.uint8), box_scene(), K_BOX, "box")
-    assert np.array_equal(parallax.sensor_view(sample.depth, sample.valid, K_BOX, np.zeros(3)), sample.depth)
+    frame = Frame.from_depth(np.zeros((48, 64, 3), np.uint8), box_scene(), K_BOX, "box")
+    assert np.array_equal(parallax.sensor_view(frame.depth, frame.valid, K_BOX, np.zeros(3)), frame.depth)
 
 
 def test_sensor_view_gives_no_return_where_the_camera_saw_nothing():
@@ -339,17 +339,17 @@ def test_sensor_view_gives_no_return_where_the_camera_saw_nothing():
 
 
 def test_parallax_sampler_is_keyed_by_example_and_its_baseline_in_range():
-    sample = random_sample(h=48, w=64, hole_fraction=0.0)
+    frame = random_frame(h=48, w=64, hole_fraction=0.0)
     sampler = Parallax(UniformSampler(300), min_m=0.05, max_m=0.1)
-    lengths = [np.linalg.norm(sampler.baseline_m(random_sample(id=str(i)), 3)) for i in range(200)]
+    lengths = [np.linalg.norm(sampler.baseline_m(random_frame(id=str(i)), 3)) for i in range(200)]
     assert 0.05 <= min(lengths) and max(lengths) <= 0.1 and np.median(lengths) == pytest.approx(0.0707, rel=0.1)
-    out = sampler(sample, seed=3)
-    assert np.array_equal(out, sampler(sample, seed=3)) and not np.array_equal(out, sampler(sample, seed=4))
+    out = sampler(frame, seed=3)
+    assert np.array_equal(out, sampler(frame, seed=3)) and not np.array_equal(out, sampler(frame, seed=4))
     # tiny baseline: the same points as the plain sampler, at the camera's depth
-    tiny = Parallax(UniformSampler(300), min_m=1e-6, max_m=1e-6)(sample, seed=3)
-    assert np.array_equal(tiny, UniformSampler(300)(sample, seed=3))
+    tiny = Parallax(UniformSampler(300), min_m=1e-6, max_m=1e-6)(frame, seed=3)
+    assert np.array_equal(tiny, UniformSampler(300)(frame, seed=3))
     rig = Parallax.at(UniformSampler(300), (0.06, -0.08, -0.27))
-    assert np.allclose(rig.baseline_m(sample, 3), (0.06, -0.08, -0.27)) and np.allclose(rig.baseline_m(sample, 9),
+    assert np.allclose(rig.baseline_m(frame, 3), (0.06, -0.08, -0.27)) and np.allclose(rig.baseline_m(frame, 9),
                                                                                       (0.06, -0.08, -0.27))
     for bad in ((0, 0, 0), (1, 2)):
         with pytest.raises(ValueError):

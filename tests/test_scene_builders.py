@@ -17,12 +17,12 @@ from lipjax.data.synthetic.street import STREET, STYLES, street_layout
 
 @pytest.mark.parametrize("kind", S.SYNTHETIC_KINDS)
 def test_build_scene_and_render_scene_give_the_rendered_frame(kind):
-    sample, info = S.render_with_info(kind, "val", 4, 40, 56)
+    frame, info = S.render_with_info(kind, "val", 4, 40, 56)
     scene_rng, noise_rng = S.frame_rngs(kind, "val", 4)
     scene = S.build_scene(kind, scene_rng)
     rgb, depth, labels = S.render_scene(scene, 40, 56, S.intrinsics_for(kind, 40, 56), noise_rng)
-    np.testing.assert_array_equal(rgb, sample.rgb)
-    np.testing.assert_array_equal(depth, sample.depth)
+    np.testing.assert_array_equal(rgb, frame.rgb)
+    np.testing.assert_array_equal(depth, frame.depth)
     np.testing.assert_array_equal(labels, info.labels)
     np.testing.assert_array_equal(scene.cam_pos, info.camera_to_world[:3, 3])
 

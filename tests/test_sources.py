@@ -140,10 +140,10 @@ def source_config(tmp_path, source: str) -> DataConfig:
 def test_kitti_input_is_the_real_scan_and_folder_input_its_sparse_maps(tmp_path):
     kitti_config = source_config(tmp_path, "kitti_dc")
     kitti = open_source(kitti_config, "train")
-    sample = kitti.dataset[1]
+    frame = kitti.dataset[1]
     scan = cv2.imread(str(tmp_path / f"kitti/depth/data_depth_velodyne/train/{DRIVE}/proj_depth/velodyne_raw/"
                                      "image_02/0000000001.png"), cv2.IMREAD_UNCHANGED) / np.float32(256)
-    assert np.array_equal(kitti.sampler(sample), scan.astype(np.float32))
+    assert np.array_equal(kitti.sampler(frame), scan.astype(np.float32))
     val = open_source(kitti_config, "val")
     assert np.count_nonzero(val.sampler(val.dataset[0])) == 20
     selection = dataclasses.replace(kitti_config, source="kitti_selection", root=str(make_kitti_selection(
@@ -511,7 +511,7 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
     from lipjax.data.protocols import get_protocol
     from lipjax.evaluate import evaluate, open_eval_source
     from lipjax.data.sampling import sampler_from_spec
-    from lipjax.data.synthetic import sample_id
+    from lipjax.data.synthetic import frame_id
     from lipjax.methods import get_completer
 
     out = render_to_disk("outdoor", "val", 2, tmp_path / "r", height=H, width=W, workers=1, progress=False)
@@ -537,7 +537,7 @@ def test_lipjax_evaluate_source_rendered_scores_the_rendered_frames(tmp_path, ca
     assert [r["id"] for r in got["per_image"]] == [RenderedDataset(out)[i].id for i in range(2)]
     synthetic, protocol = open_eval_source("synthetic", None, kind="outdoor")
     first = synthetic.dataset[0]  # the outdoor val split at the outdoor training size
-    assert (first.id, first.shape) == (sample_id("outdoor", "val", 0), (128, 416))
+    assert (first.id, first.shape) == (frame_id("outdoor", "val", 0), (128, 416))
     assert protocol.name == "synthetic_outdoor"
     with pytest.raises(ValueError, match="holds outdoor renders"):
         open_eval_source("rendered", out, kind="indoor")

@@ -10,12 +10,12 @@ import numpy as np
 import pytest
 
 from lipjax.data import synthetic as S
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 
 H, W = 48, 64  # NYU's 3:4 aspect: indoor intrinsics are then an exact isotropic resize
 
 
-def _digest(s: Sample) -> str:
+def _digest(s: Frame) -> str:
     h = hashlib.sha256()
     for a in (s.rgb, s.depth, s.valid):
         h.update(np.ascontiguousarray(a).tobytes())
@@ -59,7 +59,7 @@ def test_sample_contract(kind):
     assert s.valid.dtype == np.bool_
     np.testing.assert_array_equal(s.valid, s.depth > 0)
     assert np.isfinite(s.depth).all() and (s.depth >= 0).all()
-    assert s.id == f"synthetic/{kind}/train/000012" == S.sample_id(kind, "train", 12)
+    assert s.id == f"synthetic/{kind}/train/000012" == S.frame_id(kind, "train", 12)
     assert s.intrinsics == S.intrinsics_for(kind, H, W)
     # a usable image: not black, not blown out, not flat
     assert 15 < s.rgb.mean() < 240 and s.rgb.std() > 8

@@ -34,8 +34,8 @@ def _frames_digest(kind: str, split: str, height: int, width: int, indices) -> s
     """One sha256 over rgb, depth, labels and camera pose of every frame, in order."""
     arrays = []
     for i in indices:
-        sample, info = S.render_with_info(kind, split, i, height, width)
-        arrays += [sample.rgb, sample.depth, info.labels, info.camera_to_world]
+        frame, info = S.render_with_info(kind, split, i, height, width)
+        arrays += [frame.rgb, frame.depth, info.labels, info.camera_to_world]
     return _digest(*arrays)
 
 

@@ -91,11 +91,11 @@ def test_ranks_the_linear_fill_error_on_synthetic_test_frames():
     from lipjax.data.synthetic import SyntheticDataset
 
     ratios = []
-    for sample in SyntheticDataset("indoor", "test", size=4, height=96, width=128):  # not the frames it was fitted on
-        sparse = UniformSampler(100)(sample)
+    for frame in SyntheticDataset("indoor", "test", size=4, height=96, width=128):  # not the frames it was fitted on
+        sparse = UniformSampler(100)(frame)
         dense = linear_fill(sparse)
-        scored = sample.valid & (sparse == 0)
-        u, error = expected_error(sparse, dense)[scored], np.abs(dense - sample.depth)[scored]
+        scored = frame.valid & (sparse == 0)
+        u, error = expected_error(sparse, dense)[scored], np.abs(dense - frame.depth)[scored]
         # it ranks the error better than the distance to the samples alone (the depth-range term carries information:
         # measured 0.23-0.50 against 0.21-0.36 on these frames)
         distance = support_features(sparse)["distance"][scored]

@@ -50,7 +50,7 @@ import dataclasses
 import cv2
 import numpy as np
 
-from lipjax.data.sample import Batch
+from lipjax.data.frame import Batch
 from lipjax.data.sampling import example_rng
 
 OUTLIER_FACTOR = (1.1, 3.0)  # depth multipliers of a bleed-through outlier

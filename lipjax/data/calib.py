@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from lipjax.data.errors import dataset_error
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.pointcloud import as_intrinsics
 
 FORMATS = ("a KITTI object/tracking calib .txt (P2, R0_rect, Tr_velo_to_cam), a KITTI raw date folder "

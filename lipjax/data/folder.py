@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 
 from lipjax.data.errors import dataset_error
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.pointcloud import IntrinsicsLike, as_intrinsics
 from lipjax.utils import written_whole
 
@@ -307,7 +307,7 @@ def _rekey_by_number(files: dict[str, Path]) -> dict[str, Path]:
 
 
 class FolderDataset:
-    """A user's folder of RGB-D frames (layout in the module docstring), as Samples sorted by stem.
+    """A user's folder of RGB-D frames (layout in the module docstring), as Frames sorted by stem.
 
     Frames are matched by file stem. When no stem matches exactly, frames are matched by the trailing number
     of the stem instead (so BTS-style "rgb_00050.jpg" pairs with "sync_depth_00050.png"). Every RGB image
@@ -317,12 +317,12 @@ class FolderDataset:
       root: the folder holding rgb/ and depth/.
       depth_scale: raw PNG value per metre (required when any depth file is a PNG).
       intrinsics: overrides intrinsics files; otherwise root/intrinsics.txt, else root/intrinsics/<stem>.txt.
-      id_prefix: Sample.id = f"{id_prefix}/{stem}"; defaults to "folder/<root name>".
+      id_prefix: Frame.id = f"{id_prefix}/{stem}"; defaults to "folder/<root name>".
       intrinsics_needed: False when nothing reads the intrinsics (only the LiDAR simulation of
-        lipjax.data.sampling does): a folder without them is then no error, and its Samples carry
+        lipjax.data.sampling does): a folder without them is then no error, and its Frames carry
         UNUSED_INTRINSICS.
-      depth_dir: the folder of the Samples' depth: "depth", or SPARSE_DIR for a folder of RGB and sparse depth
-        alone (no depth/ needed), whose Samples' depth is their own sparse map: the self-supervised runs of
+      depth_dir: the folder of the Frames' depth: "depth", or SPARSE_DIR for a folder of RGB and sparse depth
+        alone (no depth/ needed), whose Frames' depth is their own sparse map: the self-supervised runs of
         lipjax.data.hidden learn from samples hidden from the input.
     """
 
@@ -358,7 +358,7 @@ class FolderDataset:
     def __len__(self) -> int:
         return len(self.keys)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         key = self.keys[index]
         rgb = read_rgb(self.rgb_paths[index])
         scale = self.depth_scale if self.depth_paths[index].suffix.lower() == ".png" else None
@@ -373,4 +373,4 @@ class FolderDataset:
             if not per_frame.is_file():
                 raise dataset_error("Per-frame intrinsics file not found", per_frame, FOLDER_LAYOUT)
             intrinsics = read_intrinsics_txt(per_frame)
-        return Sample.from_depth(rgb, depth, intrinsics, f"{self.id_prefix}/{key}")
+        return Frame.from_depth(rgb, depth, intrinsics, f"{self.id_prefix}/{key}")

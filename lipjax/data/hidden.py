@@ -28,7 +28,7 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 from lipjax.data.sampling import example_rng
 from lipjax.inputs import is_lidar_pattern
 from lipjax.resolution import is_capped, sample_spacing_px, working_size
@@ -135,34 +135,34 @@ def reproject(sparse: np.ndarray, size: tuple[int, int]) -> np.ndarray:
 
 @dataclasses.dataclass(frozen=True)
 class AtWorkingSize:
-    """A protocol step for Samples whose depth is their own sparse map (lipjax.data.folder.FolderDataset with
-    depth_dir=SPARSE_DIR): the Sample at `working_shape` of its samples, the RGB area-resized (as the default path
-    resizes it), the samples moved by `reproject`, the intrinsics scaled; the same Sample at its own size."""
+    """A protocol step for Frames whose depth is their own sparse map (lipjax.data.folder.FolderDataset with
+    depth_dir=SPARSE_DIR): the Frame at `working_shape` of its samples, the RGB area-resized (as the default path
+    resizes it), the samples moved by `reproject`, the intrinsics scaled; the same Frame at its own size."""
 
-    def __call__(self, sample: Sample) -> Sample:
-        size = working_shape(sample.depth)
-        if size == sample.shape:
-            return sample
+    def __call__(self, frame: Frame) -> Frame:
+        size = working_shape(frame.depth)
+        if size == frame.shape:
+            return frame
         h, w = size
-        rgb = cv2.resize(sample.rgb, (w, h), interpolation=cv2.INTER_AREA)
-        intrinsics = sample.intrinsics.resized(h / sample.shape[0], w / sample.shape[1])
-        return Sample.from_depth(rgb, reproject(sample.depth, size), intrinsics, sample.id)
+        rgb = cv2.resize(frame.rgb, (w, h), interpolation=cv2.INTER_AREA)
+        intrinsics = frame.intrinsics.resized(h / frame.shape[0], w / frame.shape[1])
+        return Frame.from_depth(rgb, reproject(frame.depth, size), intrinsics, frame.id)
 
 
-def without_input(sample: Sample, sparse: np.ndarray) -> Sample:
-    """`sample` with its ground truth only where it has some and the input `sparse` (metres, 0 = none) has none:
+def without_input(frame: Frame, sparse: np.ndarray) -> Frame:
+    """`frame` with its ground truth only where it has some and the input `sparse` (metres, 0 = none) has none:
     the samples hidden from the input, all that a self-supervised loss may see."""
-    hidden = sample.valid & (np.asarray(sparse) <= 0)
-    return dataclasses.replace(sample, depth=np.where(hidden, sample.depth, 0).astype(np.float32), valid=hidden)
+    hidden = frame.valid & (np.asarray(sparse) <= 0)
+    return dataclasses.replace(frame, depth=np.where(hidden, frame.depth, 0).astype(np.float32), valid=hidden)
 
 
 @dataclasses.dataclass(frozen=True)
 class HiddenInput:
     """Sampler of spec "hide[:F]": a frame's own samples less `share` of them hidden (`hidden_samples`, drawn by
-    example_rng(seed, sample.id, "hidden") at full size), moved onto the sample's grid when it is at its working size
+    example_rng(seed, frame.id, "hidden") at full size), moved onto the frame's grid when it is at its working size
     (`AtWorkingSize`).
 
-    full: what reads a frame's full-size sparse map, full.read(sample.id) -> (H, W) float32 metres
+    full: what reads a frame's full-size sparse map, full.read(frame.id) -> (H, W) float32 metres
     (lipjax.data.sources.FolderInput). A pipeline gives the example the hidden samples alone as its ground truth
     (`withholds`) and training draws other hidden samples each epoch (`redraw_each_epoch`)."""
 
@@ -171,8 +171,8 @@ class HiddenInput:
     withholds: ClassVar[bool] = True
     redraw_each_epoch: ClassVar[bool] = True
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        full = self.full.read(sample.id)
-        kept = np.where(hidden_samples(full, self.share, example_rng(seed, sample.id, "hidden")), 0.0, full)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        full = self.full.read(frame.id)
+        kept = np.where(hidden_samples(full, self.share, example_rng(seed, frame.id, "hidden")), 0.0, full)
         kept = kept.astype(np.float32)
-        return kept if kept.shape == sample.shape else reproject(kept, sample.shape)
+        return kept if kept.shape == frame.shape else reproject(kept, frame.shape)

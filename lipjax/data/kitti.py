@@ -2,7 +2,7 @@
 
 KITTI has a real sparse input (the projected Velodyne scan, `velodyne_raw`) besides the semi-dense ground
 truth (`groundtruth`, 11 accumulated scans cleaned with stereo). Loaders yield the ground truth as the
-Sample; the scan is available as `dataset.lidar(i)` / `dataset.frame(i).lidar`, and `KittiLidarInput` turns
+Frame; the scan is available as `dataset.lidar(i)` / `dataset.frame(i).lidar`, and `KittiLidarInput` turns
 it into a sampler for the batch pipeline (optionally sub-sampled to exactly N points: the paper's Table III).
 
 Depth PNGs are 16-bit, metres = value / 256, 0 = no measurement.
@@ -18,7 +18,7 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import KNOWN_DEPTH_SCALES, natural_key, read_depth, read_intrinsics_txt, read_rgb
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.sampling import example_rng, subsample_exact
 
 KITTI_CAMERAS = ("image_02", "image_03")  # left / right colour cameras
@@ -80,19 +80,19 @@ def intrinsics_from_calib(path: str | os.PathLike, camera: str = "image_02") -> 
 
 @dataclasses.dataclass(frozen=True)
 class KittiFrame:
-    """A KITTI frame: the ground-truth Sample and the real LiDAR scan.
+    """A KITTI frame: the ground-truth Frame and the real LiDAR scan.
 
     Attributes:
-      sample: RGB + ground-truth depth (metres) + intrinsics.
+      frame: RGB + ground-truth depth (metres) + intrinsics.
       lidar: (H, W) float32 projected Velodyne scan in metres, 0 = no return (the real sparse input).
     """
 
-    sample: Sample
+    frame: Frame
     lidar: np.ndarray
 
     def __post_init__(self):
-        if self.lidar.shape != self.sample.shape or self.lidar.dtype != np.float32:
-            raise ValueError(f"{self.sample.id}: lidar must be float32 {self.sample.shape}, "
+        if self.lidar.shape != self.frame.shape or self.lidar.dtype != np.float32:
+            raise ValueError(f"{self.frame.id}: lidar must be float32 {self.frame.shape}, "
                              f"got {self.lidar.dtype} {self.lidar.shape}")
 
 
@@ -106,11 +106,11 @@ class _KittiBase:
     def __len__(self) -> int:
         return len(self.ids)
 
-    def index_of(self, sample_id: str) -> int:
-        """Index of the frame with this Sample.id (KeyError if none)."""
+    def index_of(self, frame_id: str) -> int:
+        """Index of the frame with this Frame.id (KeyError if none)."""
         if not hasattr(self, "_index"):
             self._index = {sid: i for i, sid in enumerate(self.ids)}
-        return self._index[sample_id]
+        return self._index[frame_id]
 
     def rgb(self, index: int) -> np.ndarray:
         raise NotImplementedError
@@ -128,15 +128,15 @@ class _KittiBase:
     def _target(self, index: int) -> np.ndarray:
         return self.lidar(index) if self.target == "velodyne_raw" else self.ground_truth(index)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         rgb, depth = self.rgb(index), self._target(index)
         if depth.shape != rgb.shape[:2]:
             raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ for {self.ids[index]}",
                                 self._where(index))
-        return Sample.from_depth(rgb, depth, self.intrinsics(index), self.ids[index])
+        return Frame.from_depth(rgb, depth, self.intrinsics(index), self.ids[index])
 
     def frame(self, index: int) -> KittiFrame:
-        """The ground-truth Sample with its real LiDAR scan."""
+        """The ground-truth Frame with its real LiDAR scan."""
         return KittiFrame(self[index], self.lidar(index))
 
     def _where(self, index: int) -> Path:
@@ -144,9 +144,9 @@ class _KittiBase:
 
 
 class KittiDepthCompletion(_KittiBase):
-    """KITTI depth completion train / val (official tree, KITTI_DC_LAYOUT), as full-size Samples.
+    """KITTI depth completion train / val (official tree, KITTI_DC_LAYOUT), as full-size Frames.
 
-    Sample.id = "kitti/<split>/<drive>/<camera>/<frame>"; sorted by drive, camera, frame.
+    Frame.id = "kitti/<split>/<drive>/<camera>/<frame>"; sorted by drive, camera, frame.
 
     Args:
       depth_root: holds data_depth_annotated/ and data_depth_velodyne/.
@@ -228,7 +228,7 @@ _SELECTION_NAME = re.compile(r"^(?P<drive>.+)_image_(?P<frame>\d+)_(?P<camera>im
 class KittiSelection(_KittiBase):
     """KITTI depth_selection/val_selection_cropped (1000 frames, already 352x1216, KITTI_SELECTION_LAYOUT).
 
-    The intrinsics files already account for the crop. Sample.id = "kitti/selection/<drive>/<camera>/<frame>".
+    The intrinsics files already account for the crop. Frame.id = "kitti/selection/<drive>/<camera>/<frame>".
 
     Args:
       root: the directory holding depth_selection/, or depth_selection/ itself, or val_selection_cropped/ itself.
@@ -294,13 +294,13 @@ class KittiSelection(_KittiBase):
 class KittiLidarInput:
     """A sampler (same call signature) whose sparse input is the frame's REAL Velodyne scan.
 
-    The scan is looked up by Sample.id in `dataset`, cropped with the same protocol as the Sample, and
+    The scan is looked up by Frame.id in `dataset`, cropped with the same protocol as the Frame, and
     optionally sub-sampled to exactly num_points measured pixels (example_rng(seed, id); all of them when the
     scan has fewer) to simulate a sparser LiDAR.
 
     Attributes:
       dataset: a KittiDepthCompletion or KittiSelection (anything with index_of(id) and lidar(index)).
-      protocol: the protocol the pipeline applies to the Samples (None: no crop).
+      protocol: the protocol the pipeline applies to the Frames (None: no crop).
       num_points: None keeps every return.
     """
 
@@ -308,13 +308,13 @@ class KittiLidarInput:
     protocol: object | None = None
     num_points: int | None = None
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        lidar = self.dataset.lidar(self.dataset.index_of(sample.id))
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        lidar = self.dataset.lidar(self.dataset.index_of(frame.id))
         if self.protocol is not None:
             lidar = self.protocol.apply_to_depth(lidar)
-        if lidar.shape != sample.shape:
-            raise ValueError(f"{sample.id}: LiDAR {lidar.shape} does not match the sample {sample.shape}; "
+        if lidar.shape != frame.shape:
+            raise ValueError(f"{frame.id}: LiDAR {lidar.shape} does not match the frame {frame.shape}; "
                              "pass the pipeline's protocol to KittiLidarInput")
         if self.num_points is not None:
-            lidar = subsample_exact(lidar, self.num_points, example_rng(seed, sample.id))
+            lidar = subsample_exact(lidar, self.num_points, example_rng(seed, frame.id))
         return lidar.astype(np.float32, copy=False)

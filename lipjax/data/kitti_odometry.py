@@ -20,7 +20,7 @@ import numpy as np
 from lipjax.data.calib import read_odometry_calib
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import natural_key, read_rgb
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.pointcloud import project_lidar_to_depth, read_point_cloud
 
 KITTI_ODOMETRY_LAYOUT = """\
@@ -40,12 +40,12 @@ def read_velodyne_bin(path: str | os.PathLike) -> np.ndarray:
 
 
 class KittiOdometry:
-    """Frames of KITTI odometry sequences as Samples whose depth is the projected scan (see module docstring).
+    """KITTI odometry sequences as Frames whose depth is the projected scan (see module docstring).
 
     Args:
       root: the folder holding `sequences/`.
       sequences: sequence names, e.g. ("00", "01"); default: every sequence with images and scans.
-    Sample.id = "kitti_odometry/<SS>/<NNNNNN>".
+    Frame.id = "kitti_odometry/<SS>/<NNNNNN>".
     """
 
     def __init__(self, root: str | os.PathLike, sequences: tuple[str, ...] | None = None):
@@ -73,9 +73,9 @@ class KittiOdometry:
     def __len__(self) -> int:
         return len(self.frames)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         seq, image_path, scan_path = self.frames[index]
         rgb = read_rgb(image_path)
         intrinsics, cam_from_velo = self.calib[seq]
         depth = project_lidar_to_depth(read_velodyne_bin(scan_path), intrinsics, cam_from_velo, rgb.shape[:2])
-        return Sample.from_depth(rgb, depth, intrinsics, f"kitti_odometry/{seq}/{image_path.stem}")
+        return Frame.from_depth(rgb, depth, intrinsics, f"kitti_odometry/{seq}/{image_path.stem}")

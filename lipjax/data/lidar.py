@@ -30,7 +30,7 @@ import numpy as np
 
 from lipjax.data.calib import calibration_format, read_calibration
 from lipjax.data.folder import read_rgb
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.inputs import MAX_PLAUSIBLE_DEPTH_M, is_lidar_pattern, unit_hint
 from lipjax.pointcloud import ProjectionCounts, project_lidar_to_depth, read_point_cloud
 from lipjax.utils import warn_user

@@ -1,6 +1,6 @@
 """NYU Depth v2 loaders: the h5 files of Ma & Karaman / FastDepth, and a prepared TFDS `nyu_depth_v2`.
 
-Samples are the raw 480x640 frames; apply protocols.NYU_PAPER (or NYU_MA) for the benchmark crop.
+Loaders yield the raw 480x640 frames; apply protocols.NYU_PAPER (or NYU_MA) for the benchmark crop.
 """
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import natural_key
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 
 # NYU Depth v2 RGB camera (the registered depth shares it), at 480x640, in pixels.
 NYU_INTRINSICS = Intrinsics(fx=518.8579, fy=519.46961, cx=325.58245, cy=253.73617)
@@ -26,9 +26,9 @@ NYU_H5_SOURCE = (
 
 
 class NyuH5Dataset:
-    """NYU Depth v2 in the h5 layout of Ma et al. / FastDepth (see NYU_H5_LAYOUT), as raw 480x640 Samples.
+    """NYU Depth v2 in the h5 layout of Ma et al. / FastDepth (see NYU_H5_LAYOUT), as raw 480x640 Frames.
 
-    Frames are sorted by scene, then by the numeric file stem. Sample.id = "nyu/<split>/<scene>/<stem>".
+    Frames are sorted by scene, then by the numeric file stem. Frame.id = "nyu/<split>/<scene>/<stem>".
 
     Args:
       root: the nyudepthv2 directory, or its parent.
@@ -54,10 +54,10 @@ class NyuH5Dataset:
     def __len__(self) -> int:
         return len(self.files)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         path = self.files[index]
         rgb, depth = read_nyu_h5(path)
-        return Sample.from_depth(rgb, depth, self.intrinsics, f"nyu/{self.split}/{path.parent.name}/{path.stem}")
+        return Frame.from_depth(rgb, depth, self.intrinsics, f"nyu/{self.split}/{path.parent.name}/{path.stem}")
 
 
 def read_nyu_h5(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray]:
@@ -90,7 +90,7 @@ class NyuTfdsDataset:
 
     The data set must already be prepared in ArrayRecord format under data_dir (e.g. `tfds build nyu_depth_v2
     --file_format=array_record`). Features: 'image' uint8 (480, 640, 3), 'depth' float (480, 640) metres.
-    Sample.id = "nyu/tfds/<split>/<index:05d>" (split "train" or "validation").
+    Frame.id = "nyu/tfds/<split>/<index:05d>" (split "train" or "validation").
 
     Args:
       split: "train", "val" or "validation".
@@ -122,12 +122,12 @@ class NyuTfdsDataset:
     def __len__(self) -> int:
         return len(self.source)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         if not 0 <= index < len(self):
             raise IndexError(index)
         example = self.source[index]
         depth = np.asarray(example["depth"], dtype=np.float32)
         if depth.ndim == 3:
             depth = depth[..., 0]
-        return Sample.from_depth(np.asarray(example["image"], np.uint8), depth, self.intrinsics,
-                                 f"nyu/tfds/{self.split}/{index:05d}")
+        return Frame.from_depth(np.asarray(example["image"], np.uint8), depth, self.intrinsics,
+                                f"nyu/tfds/{self.split}/{index:05d}")

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.pointcloud import backproject, project_lidar_to_depth
 
 MIN_VIEW_DEPTH_M = 0.05  # points closer than this to the sensor (or behind it) are not seen

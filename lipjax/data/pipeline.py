@@ -32,8 +32,8 @@ from typing import Any, Iterator, Sequence
 import numpy as np
 
 from lipjax.data.augment import Augment, augment_batch
+from lipjax.data.frame import Batch, Frame
 from lipjax.data.hidden import HiddenInput, without_input
-from lipjax.data.sample import Batch, Sample
 from lipjax.data.sampling import SparseSampler
 from lipjax.utils import exit_when_orphaned
 
@@ -43,13 +43,13 @@ WORKER_BUFFER = 2  # batches each worker process prepares ahead
 
 
 class BatchIterator:
-    """Deterministic, resumable batches of (protocol-applied) Samples with their sparse inputs.
+    """Deterministic, resumable batches of (protocol-applied) Frames with their sparse inputs.
 
     Args:
-      dataset: indexable: len(dataset) and dataset[i] -> Sample (raw frames).
+      dataset: indexable: len(dataset) and dataset[i] -> Frame (raw frames).
       batch_size: GLOBAL batch size (over all processes).
-      sampler: draws the sparse input, sampler(sample, sample_seed) -> (H, W) float32 metres.
-      protocol: applied to each Sample before sampling (None: samples must already share one size).
+      sampler: draws the sparse input, sampler(frame, sample_seed) -> (H, W) float32 metres.
+      protocol: applied to each Frame before sampling (None: frames must already share one size).
       seed: seed of the per-epoch shuffles.
       shuffle: permute each epoch (training) or keep dataset order (evaluation).
       drop_last: drop the last incomplete batch of an epoch (required when process_count > 1).
@@ -110,25 +110,25 @@ class BatchIterator:
         per = len(indices) // self.process_count
         return indices[self.process_index * per : (self.process_index + 1) * per]
 
-    def example(self, index: int, epoch: int | None = None) -> tuple[Sample, np.ndarray]:
-        """(protocol-applied Sample, (H, W) float32 sparse depth in metres) of dataset[index]. A sampler that
-        `withholds` its input from the ground truth (lipjax.data.hidden.HiddenInput) gives a Sample whose ground truth
+    def example(self, index: int, epoch: int | None = None) -> tuple[Frame, np.ndarray]:
+        """(protocol-applied Frame, (H, W) float32 sparse depth in metres) of dataset[index]. A sampler that
+        `withholds` its input from the ground truth (lipjax.data.hidden.HiddenInput) gives a Frame whose ground truth
         is where the input has no sample (lipjax.data.hidden.without_input); one that asks to `redraw_each_epoch`
         draws with `redraw_seed` of `epoch` (training; None: sample_seed, as validation draws)."""
-        sample = self.dataset[int(index)]
+        frame = self.dataset[int(index)]
         if self.protocol is not None:
-            sample = self.protocol(sample)
+            frame = self.protocol(frame)
         seed = self.sample_seed
         if epoch is not None and isinstance(self.sampler, HiddenInput) and self.sampler.redraw_each_epoch:
             seed = redraw_seed(self.sample_seed, self.seed, epoch)
-        sparse = np.asarray(self.sampler(sample, seed), dtype=np.float32)
-        if sparse.shape != sample.shape:
-            raise ValueError(f"sampler returned {sparse.shape} for {sample.id!r} of shape {sample.shape}")
+        sparse = np.asarray(self.sampler(frame, seed), dtype=np.float32)
+        if sparse.shape != frame.shape:
+            raise ValueError(f"sampler returned {sparse.shape} for {frame.id!r} of shape {frame.shape}")
         if isinstance(self.sampler, HiddenInput) and self.sampler.withholds:
-            sample = without_input(sample, sparse)
-        return sample, sparse
+            frame = without_input(frame, sparse)
+        return frame, sparse
 
-    def examples(self, step: int) -> list[tuple[Sample, np.ndarray]]:
+    def examples(self, step: int) -> list[tuple[Frame, np.ndarray]]:
         """This process's examples of global step `step`, as `example` gives them (frames of any sizes)."""
         epoch = self.position(step)[0]
         return [self.example(i, epoch) for i in self.local_indices(step)]
@@ -161,8 +161,8 @@ def redraw_seed(sample_seed: int, seed: int, epoch: int) -> int:
     return int(np.random.SeedSequence([sample_seed, seed, epoch]).generate_state(1)[0])
 
 
-def stacked(examples: list[tuple[Sample, np.ndarray]], what: str = "a batch") -> Batch:
-    """A Batch of (Sample, sparse) examples of one size; a one-line ValueError names the sizes otherwise."""
+def stacked(examples: list[tuple[Frame, np.ndarray]], what: str = "a batch") -> Batch:
+    """A Batch of (Frame, sparse) examples of one size; a one-line ValueError names the sizes otherwise."""
     shapes = {s.shape for s, _ in examples}
     if len(shapes) > 1:
         raise ValueError(f"the frames of {what} have different sizes {sorted(shapes)}; train with a crop "

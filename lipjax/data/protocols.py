@@ -1,6 +1,6 @@
 """Named evaluation protocols: the exact crops, resizes and depth ranges each benchmark uses, in one place.
 
-A protocol maps a raw loader Sample to the benchmark's input size and says which ground-truth depths count
+A protocol maps a raw loader Frame to the benchmark's input size and says which ground-truth depths count
 in evaluation. Geometry rules shared by every step:
 
 - RGB is resampled with area interpolation when shrinking and bilinear when enlarging (cv2).
@@ -40,13 +40,13 @@ from typing import Any, Protocol as _TypingProtocol, Sequence
 import cv2
 import numpy as np
 
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 
 
 class Step(_TypingProtocol):
     """One geometric step of a protocol."""
 
-    def apply(self, sample: Sample) -> Sample: ...
+    def apply(self, frame: Frame) -> Frame: ...
 
     def apply_to_depth(self, depth: np.ndarray) -> np.ndarray: ...
 
@@ -66,15 +66,15 @@ class _Crop:
             raise ValueError(f"{self} needs an input of at least {self.height}x{self.width}, got {in_h}x{in_w}")
         return self.offsets(in_h, in_w)
 
-    def apply(self, sample: Sample) -> Sample:
-        top, left = self._window(*sample.shape)
+    def apply(self, frame: Frame) -> Frame:
+        top, left = self._window(*frame.shape)
         rows, cols = slice(top, top + self.height), slice(left, left + self.width)
-        return Sample(
-            np.ascontiguousarray(sample.rgb[rows, cols]),
-            np.ascontiguousarray(sample.depth[rows, cols]),
-            np.ascontiguousarray(sample.valid[rows, cols]),
-            sample.intrinsics.cropped(top, left),
-            sample.id,
+        return Frame(
+            np.ascontiguousarray(frame.rgb[rows, cols]),
+            np.ascontiguousarray(frame.depth[rows, cols]),
+            np.ascontiguousarray(frame.valid[rows, cols]),
+            frame.intrinsics.cropped(top, left),
+            frame.id,
         )
 
     def apply_to_depth(self, depth: np.ndarray) -> np.ndarray:
@@ -114,20 +114,20 @@ class Resize:
     height: int
     width: int
 
-    def apply(self, sample: Sample) -> Sample:
-        in_h, in_w = sample.shape
+    def apply(self, frame: Frame) -> Frame:
+        in_h, in_w = frame.shape
         if (in_h, in_w) == (self.height, self.width):
-            return sample
+            return frame
         shrinking = self.height <= in_h and self.width <= in_w
-        rgb = cv2.resize(sample.rgb, (self.width, self.height),
+        rgb = cv2.resize(frame.rgb, (self.width, self.height),
                          interpolation=cv2.INTER_AREA if shrinking else cv2.INTER_LINEAR)
         rows, cols = nearest_indices(in_h, self.height), nearest_indices(in_w, self.width)
-        return Sample(
+        return Frame(
             np.ascontiguousarray(rgb),
-            np.ascontiguousarray(sample.depth[np.ix_(rows, cols)]),
-            np.ascontiguousarray(sample.valid[np.ix_(rows, cols)]),
-            sample.intrinsics.resized(self.height / in_h, self.width / in_w),
-            sample.id,
+            np.ascontiguousarray(frame.depth[np.ix_(rows, cols)]),
+            np.ascontiguousarray(frame.valid[np.ix_(rows, cols)]),
+            frame.intrinsics.resized(self.height / in_h, self.width / in_w),
+            frame.id,
         )
 
     def apply_to_depth(self, depth: np.ndarray) -> np.ndarray:
@@ -144,7 +144,7 @@ class EvalProtocol:
 
     Attributes:
       name: registry key.
-      steps: geometric steps applied in order to the raw Sample.
+      steps: geometric steps applied in order to the raw Frame.
       output_size: (H, W) every output has; checked after the steps.
       min_depth_m, max_depth_m: ground truth counts in evaluation where min_depth_m < gt <= max_depth_m
         (and gt is valid). max_depth_m may be math.inf (no cap).
@@ -158,14 +158,14 @@ class EvalProtocol:
     max_depth_m: float
     description: str = ""
 
-    def __call__(self, sample: Sample) -> Sample:
-        """Applies the steps; returns a Sample of size output_size, same id, intrinsics transformed."""
+    def __call__(self, frame: Frame) -> Frame:
+        """Applies the steps; returns a Frame of size output_size, same id, intrinsics transformed."""
         for step in self.steps:
-            sample = step.apply(sample)
-        if sample.shape != self.output_size:
-            raise ValueError(f"protocol {self.name!r} produced {sample.shape} for {sample.id!r}, "
+            frame = step.apply(frame)
+        if frame.shape != self.output_size:
+            raise ValueError(f"protocol {self.name!r} produced {frame.shape} for {frame.id!r}, "
                              f"expected {self.output_size}")
-        return sample
+        return frame
 
     def apply_to_depth(self, depth: np.ndarray) -> np.ndarray:
         """Applies the same geometry (nearest) to another (H, W) depth map of the raw frame, e.g. real LiDAR.
@@ -287,5 +287,5 @@ class ProtocolView:
     def __len__(self) -> int:
         return len(self.dataset)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         return self.protocol(self.dataset[index])

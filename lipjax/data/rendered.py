@@ -13,7 +13,7 @@ Layout of a rendered folder (no pickle anywhere; every array file is a plain .np
     <root>/shard-00000.depth.npy      (n, h, w) uint16, metres = value / depth_scale, 0 = invalid
     <root>/shard-00000.window.npy     (n, 2) int32 (top, left) of each frame's window (only with a window)
 
-Frame i lives in shard i // shard_size. Sample ids are those of the on-the-fly set (sample_id(kind, split, i)),
+Frame i lives in shard i // shard_size. Frame ids are those of the on-the-fly set (frame_id(kind, split, i)),
 so a sampler draws the same sparse points from a rendered frame as from the on-the-fly one.
 
 Window. With `window=(h, w)`, each frame is a h x w window of the height x width camera, rendered directly
@@ -38,7 +38,7 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import KNOWN_DEPTH_SCALES
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.sampling import example_rng
 from lipjax.utils import die_with_parent
 
@@ -78,32 +78,32 @@ class RenderSpec:
 
 
 def window_corner(spec: RenderSpec, index: int) -> tuple[int, int]:
-    """(top, left) of frame `index`'s window, drawn from its sample id (0, 0 without a window)."""
-    from lipjax.data.synthetic import sample_id
+    """(top, left) of frame `index`'s window, drawn from its frame id (0, 0 without a window)."""
+    from lipjax.data.synthetic import frame_id
 
     if spec.window is None:
         return 0, 0
     h, w = spec.window
-    top, left = example_rng(0, sample_id(spec.kind, spec.split, index), "window").integers(
+    top, left = example_rng(0, frame_id(spec.kind, spec.split, index), "window").integers(
         0, (spec.height - h + 1, spec.width - w + 1))
     return int(top), int(left)
 
 
 def _render_frame(spec: RenderSpec, index: int) -> tuple[np.ndarray, np.ndarray]:
     """(rgb (h, w, 3) uint8, depth (h, w) float32 metres) of one frame (its window when spec.window is set)."""
-    from lipjax.data.synthetic import build_scene, frame_rngs, intrinsics_for, render, render_scene, sample_id
+    from lipjax.data.synthetic import build_scene, frame_rngs, intrinsics_for, render, render_scene, frame_id
 
     if spec.window is None:
-        sample = render(spec.kind, spec.split, index, spec.height, spec.width)
-        return sample.rgb, sample.depth
+        frame = render(spec.kind, spec.split, index, spec.height, spec.width)
+        return frame.rgb, frame.depth
     top, left = window_corner(spec, index)
     scene_rng, noise_rng = frame_rngs(spec.kind, spec.split, index)
     scene = build_scene(spec.kind, scene_rng)
     intr = intrinsics_for(spec.kind, spec.height, spec.width).cropped(top, left)
     with np.errstate(all="ignore"):
         rgb, depth, _ = render_scene(scene, spec.window[0], spec.window[1], intr, noise_rng)
-    sample = Sample.from_depth(rgb, depth, intr, sample_id(spec.kind, spec.split, index))
-    return sample.rgb, sample.depth
+    frame = Frame.from_depth(rgb, depth, intr, frame_id(spec.kind, spec.split, index))
+    return frame.rgb, frame.depth
 
 
 def _shard_stem(shard: int) -> str:
@@ -252,10 +252,10 @@ def render_to_disk(kind: str, split: str, count: int, out: str | os.PathLike, *,
 
 
 class RenderedDataset:
-    """A folder written by render_to_disk, as Samples (memory-mapped shards; loads only the frames asked for).
+    """A folder written by render_to_disk, as Frames (memory-mapped shards; loads only the frames asked for).
 
     dataset[i] has rgb uint8, depth float32 metres (the stored uint16 / depth_scale), valid = depth > 0, the
-    frame's intrinsics (its window's when rendered with one) and id = sample_id(kind, split, i).
+    frame's intrinsics (its window's when rendered with one) and id = frame_id(kind, split, i).
 
     Args:
       root: the folder holding index.json.
@@ -304,8 +304,8 @@ class RenderedDataset:
             self._shards[shard] = arrays
         return self._shards[shard]
 
-    def __getitem__(self, index: int) -> Sample:
-        from lipjax.data.synthetic import sample_id
+    def __getitem__(self, index: int) -> Frame:
+        from lipjax.data.synthetic import frame_id
 
         if not 0 <= int(index) < self.count:
             raise IndexError(f"index {index} out of range for {self.count} rendered frames in {self.root}")
@@ -316,8 +316,8 @@ class RenderedDataset:
         if self.window:
             top, left = (int(v) for v in arrays["window"][row])
             intrinsics = intrinsics.cropped(top, left)
-        return Sample.from_depth(np.array(arrays["rgb"][row]), depth, intrinsics,
-                                 sample_id(self.kind, self.split, int(index)))
+        return Frame.from_depth(np.array(arrays["rgb"][row]), depth, intrinsics,
+                                frame_id(self.kind, self.split, int(index)))
 
     def __getstate__(self) -> dict:  # worker processes reopen the memory maps themselves
         return {**self.__dict__, "_shards": {}}
@@ -331,7 +331,7 @@ class RenderedMixture:
     """Several rendered folders of one frame size as one data set: their frames one folder after another.
 
     For training one model on several kinds of scene (rooms and streets), e.g. `data.root=A,B` with
-    `source="rendered"` (lipjax.data.sources). Frames keep their own folder's intrinsics and sample ids.
+    `source="rendered"` (lipjax.data.sources). Frames keep their own folder's intrinsics and frame ids.
 
     Args:
       parts: the RenderedDatasets, every one with the same frame_size (batches stack frames of one size).
@@ -351,7 +351,7 @@ class RenderedMixture:
     def __len__(self) -> int:
         return int(self._ends[-1])
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         if not 0 <= int(index) < len(self):
             raise IndexError(f"index {index} out of range for {len(self)} rendered frames")
         part = int(np.searchsorted(self._ends, int(index), side="right"))

@@ -1,8 +1,8 @@
 """Sparse depth samplers: which ground-truth pixels become the sparse input y (mask m = y > 0).
 
-Every sampler is a frozen dataclass called as `sampler(sample, seed=0) -> (H, W) float32` sparse depth in
-metres, 0 = no sample. Randomness comes only from `example_rng(seed, sample.id)`, a numpy Generator seeded
-with sha256(f"{seed}/{sample.id}"): an example gets the same points in every run, process and data order,
+Every sampler is a frozen dataclass called as `sampler(frame, seed=0) -> (H, W) float32` sparse depth in
+metres, 0 = no sample. Randomness comes only from `example_rng(seed, frame.id)`, a numpy Generator seeded
+with sha256(f"{seed}/{frame.id}"): an example gets the same points in every run, process and data order,
 and "200 points" means the same 200 points at training, validation and test time.
 
 Samplers:
@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 
 from lipjax.data import parallax
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 from lipjax.zbuffer import nearest_per_cell
 
 DEFAULT_SAMPLER = "uniform:200"  # the sparse input where the data have none of their own (the paper's Table I)
@@ -40,16 +40,16 @@ MIN_SPARSE_DEPTH_M = 1e-3
 
 
 class SparseSampler(Protocol):
-    """What every sampler is: called with a Sample (its depth (H, W) float32 metres and validity mask) and a seed,
-    it returns the sparse input, (H, W) float32 metres with 0 = no sample; the same (seed, sample.id) always gives
+    """What every sampler is: called with a Frame (its depth (H, W) float32 metres and validity mask) and a seed,
+    it returns the sparse input, (H, W) float32 metres with 0 = no sample; the same (seed, frame.id) always gives
     the same samples (`example_rng`)."""
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray: ...
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray: ...
 
 
-def example_rng(seed: int, sample_id: str, stream: str = "") -> np.random.Generator:
-    """numpy Generator keyed by sha256(f"{seed}/{sample_id}") (plus f"/{stream}" for an independent stream)."""
-    key = f"{seed}/{sample_id}" + (f"/{stream}" if stream else "")
+def example_rng(seed: int, frame_id: str, stream: str = "") -> np.random.Generator:
+    """numpy Generator keyed by sha256(f"{seed}/{frame_id}") (plus f"/{stream}" for an independent stream)."""
+    key = f"{seed}/{frame_id}" + (f"/{stream}" if stream else "")
     digest = hashlib.sha256(key.encode("utf-8")).digest()
     return np.random.Generator(np.random.PCG64(int.from_bytes(digest[:16], "little")))
 
@@ -81,8 +81,8 @@ class UniformSampler:
 
     num_points: int
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        return subsample_exact(np.where(sample.valid, sample.depth, 0), self.num_points, example_rng(seed, sample.id))
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        return subsample_exact(np.where(frame.valid, frame.depth, 0), self.num_points, example_rng(seed, frame.id))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -92,12 +92,12 @@ class BernoulliSampler:
 
     num_points: int
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        valid = sample.valid & (sample.depth > 0)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        valid = frame.valid & (frame.depth > 0)
         n_valid = int(valid.sum())
         prob = min(1.0, self.num_points / n_valid) if n_valid else 0.0
-        keep = valid & (example_rng(seed, sample.id).random(sample.shape) < prob)
-        return np.where(keep, sample.depth, 0).astype(np.float32)
+        keep = valid & (example_rng(seed, frame.id).random(frame.shape) < prob)
+        return np.where(keep, frame.depth, 0).astype(np.float32)
 
 
 KEYPOINT_QUALITY = (1e-3, 5e-2)  # range of the corner threshold, relative to the frame's strongest corner
@@ -120,17 +120,17 @@ class KeypointSampler:
         if self.num_points < 0:
             raise ValueError(f"num_points must be >= 0, got {self.num_points}")
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        rng = example_rng(seed, sample.id)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        rng = example_rng(seed, frame.id)
         quality = float(np.exp(rng.uniform(*np.log(KEYPOINT_QUALITY))))
-        valid = sample.valid & (sample.depth > 0)
-        grey = cv2.cvtColor(np.ascontiguousarray(sample.rgb), cv2.COLOR_RGB2GRAY)
+        valid = frame.valid & (frame.depth > 0)
+        grey = cv2.cvtColor(np.ascontiguousarray(frame.rgb), cv2.COLOR_RGB2GRAY)
         corners = cv2.goodFeaturesToTrack(grey, maxCorners=self.num_points, qualityLevel=quality,
                                           minDistance=KEYPOINT_MIN_DISTANCE_PX, mask=valid.astype(np.uint8))
-        out = np.zeros(sample.shape, np.float32)
+        out = np.zeros(frame.shape, np.float32)
         if corners is not None and self.num_points > 0:  # maxCorners=0 means no limit to OpenCV
             cols, rows = np.round(corners.reshape(-1, 2)).astype(np.int64).T  # whole pixels, inside the mask
-            out[rows, cols] = sample.depth[rows, cols]
+            out[rows, cols] = frame.depth[rows, cols]
         return out
 
 
@@ -155,11 +155,11 @@ class HolesSampler:
         if not 0 <= self.fraction < 1:
             raise ValueError(f"holes fraction must be in [0, 1), got {self.fraction}")
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        rng = example_rng(seed, sample.id)
-        h, w = sample.shape
-        valid = sample.valid & (sample.depth > 0)
-        log_d = np.log(np.where(valid, sample.depth, 1.0))
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        rng = example_rng(seed, frame.id)
+        h, w = frame.shape
+        valid = frame.valid & (frame.depth > 0)
+        log_d = np.log(np.where(valid, frame.depth, 1.0))
         edge_y = valid[:-1] & valid[1:] & (np.abs(np.diff(log_d, axis=0)) > HOLE_EDGE)
         edge_x = valid[:, :-1] & valid[:, 1:] & (np.abs(np.diff(log_d, axis=1)) > HOLE_EDGE)
         keep = valid.copy()
@@ -173,7 +173,7 @@ class HolesSampler:
             field = cv2.resize(rng.uniform(0, 1, cells).astype(np.float32), (w, h),
                                interpolation=cv2.INTER_CUBIC)
             keep &= field >= np.quantile(field, self.fraction)
-        return np.where(keep, sample.depth, 0).astype(np.float32)
+        return np.where(keep, frame.depth, 0).astype(np.float32)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -251,12 +251,12 @@ class LidarSampler:
         lo, hi = self.vertical_fov_deg
         return np.linspace(lo, hi, self.beams) if self.beams > 1 else np.array([lo])
 
-    def angles(self, sample: Sample) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def angles(self, frame: Frame) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Flat indices of the valid pixels and their LiDAR-frame (elevation, azimuth) in radians and range (m)."""
-        idx = np.flatnonzero(sample.valid & (sample.depth > 0))
-        v, u = np.divmod(idx, sample.shape[1])
-        z = sample.depth.reshape(-1)[idx].astype(np.float64)
-        k = sample.intrinsics
+        idx = np.flatnonzero(frame.valid & (frame.depth > 0))
+        v, u = np.divmod(idx, frame.shape[1])
+        z = frame.depth.reshape(-1)[idx].astype(np.float64)
+        k = frame.intrinsics
         x = (u - k.cx) / k.fx * z
         y = (v - k.cy) / k.fy * z
         # Camera frame -> LiDAR-origin frame: translate, then rotate about x by the pitch.
@@ -271,8 +271,8 @@ class LidarSampler:
         azimuth = np.arctan2(x, z_l)
         return idx, elevation, azimuth, np.sqrt(horizontal**2 + y_l**2)
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        idx, elevation, azimuth, rng_m = self.angles(sample)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        idx, elevation, azimuth, rng_m = self.angles(frame)
         beams = np.radians(self.beam_elevations_deg())
         # A single beam has no spacing: give it an (arbitrary) band of +-0.2 deg.
         spacing = (beams[-1] - beams[0]) / (self.beams - 1) if self.beams > 1 else math.radians(0.4)
@@ -285,8 +285,8 @@ class LidarSampler:
         # A ray hits the pixel that contains it: a pixel more than about half its own angular size away from
         # the cell centre is not hit (the ray leaves the image or falls on invalid ground truth). Local pixel
         # pitch of the camera ray angles: d(elevation)/dv and d(azimuth)/du at this pixel (+10 % margin).
-        v, u = np.divmod(idx, sample.shape[1])
-        k = sample.intrinsics
+        v, u = np.divmod(idx, frame.shape[1])
+        k = frame.intrinsics
         dx, dy = (u - k.cx) / k.fx, (v - k.cy) / k.fy
         el_pitch = np.sqrt(dx**2 + 1) / (dx**2 + dy**2 + 1) / k.fy
         az_pitch = 1.0 / (dx**2 + 1) / k.fx
@@ -298,15 +298,15 @@ class LidarSampler:
         )
         idx, beam, column, cost = idx[keep], beam[keep], column[keep], (d_el**2 + d_az**2)[keep]
         if idx.size == 0:
-            return np.zeros(sample.shape, dtype=np.float32)
+            return np.zeros(frame.shape, dtype=np.float32)
         column = column - column.min()
         cell = beam * (int(column.max()) + 1) + column
         chosen = idx[nearest_per_cell(cell, cost, tiebreak=idx)]  # per cell: nearest to the centre
         if self.dropout > 0 and chosen.size:
-            chosen = chosen[example_rng(seed, sample.id).random(chosen.size) >= self.dropout]
-        out = np.zeros(sample.depth.size, dtype=np.float32)
-        out[chosen] = sample.depth.reshape(-1)[chosen]
-        return out.reshape(sample.shape)
+            chosen = chosen[example_rng(seed, frame.id).random(chosen.size) >= self.dropout]
+        out = np.zeros(frame.depth.size, dtype=np.float32)
+        out[chosen] = frame.depth.reshape(-1)[chosen]
+        return out.reshape(frame.shape)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -316,7 +316,7 @@ class Noise:
     Per point with depth d: d + N(0, std_m^2 + (relative_std * d)^2); then exactly
     round(outlier_fraction * #points) points are replaced by outliers uniform in outlier_range_m (default: the
     [min, max] of the example's valid ground truth). Results are clamped to >= MIN_SPARSE_DEPTH_M so no point
-    disappears. Randomness: example_rng(seed, sample_id, "noise"), independent of the sampler's draws.
+    disappears. Randomness: example_rng(seed, frame_id, "noise"), independent of the sampler's draws.
 
     Attributes:
       std_m: additive Gaussian std in metres.
@@ -334,9 +334,9 @@ class Noise:
         if self.std_m < 0 or self.relative_std < 0 or not 0 <= self.outlier_fraction <= 1:
             raise ValueError(f"invalid noise parameters: {self}")
 
-    def __call__(self, sparse: np.ndarray, sample: Sample, seed: int = 0) -> np.ndarray:
+    def __call__(self, sparse: np.ndarray, frame: Frame, seed: int = 0) -> np.ndarray:
         """(H, W) sparse metres -> (H, W) float32 noisy sparse metres, same support."""
-        rng = example_rng(seed, sample.id, "noise")
+        rng = example_rng(seed, frame.id, "noise")
         out = np.array(sparse, dtype=np.float32, copy=True)
         idx = np.flatnonzero(out > 0)
         flat = out.reshape(-1)
@@ -348,7 +348,7 @@ class Noise:
             if self.outlier_range_m is not None:
                 low, high = self.outlier_range_m
             else:
-                gt = sample.depth[sample.valid]
+                gt = frame.depth[frame.valid]
                 low, high = (float(gt.min()), float(gt.max())) if gt.size else (MIN_SPARSE_DEPTH_M, 1.0)
             which = rng.choice(idx.size, size=n_out, replace=False)
             d[which] = rng.uniform(low, high, size=n_out)
@@ -363,8 +363,8 @@ class Noisy:
     sampler: SparseSampler
     noise: Noise
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        return self.noise(self.sampler(sample, seed), sample, seed)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        return self.noise(self.sampler(frame, seed), frame, seed)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -372,7 +372,7 @@ class Parallax:
     """`sampler` measuring from a sensor beside the camera, its returns projected into the image.
 
     Per example a baseline b (metres, camera frame) of length drawn log-uniformly in [min_m, max_m] and direction
-    uniform on the sphere, from example_rng(seed, sample.id, "parallax"); `Parallax.at(sampler, b)` fixes it (a
+    uniform on the sphere, from example_rng(seed, frame.id, "parallax"); `Parallax.at(sampler, b)` fixes it (a
     known rig: KITTI's Velodyne sits at about (0.06, -0.08, -0.27) from its left colour camera). The sampler draws
     on the depth the sensor sees from b (`lipjax.data.parallax.sensor_view`: the camera's hidden background
     continued under edges, its invalid pixels kept invalid), and its returns land back in the camera's pixels
@@ -402,18 +402,18 @@ class Parallax:
             raise ValueError(f"a sensor position needs 3 coordinates in metres, not all 0, got {baseline_m!r}")
         return cls(sampler, length, length, tuple(float(c) for c in b / length))
 
-    def baseline_m(self, sample: Sample, seed: int = 0) -> np.ndarray:
+    def baseline_m(self, frame: Frame, seed: int = 0) -> np.ndarray:
         """(3,) this example's sensor position in the camera frame, metres."""
-        rng = example_rng(seed, sample.id, "parallax")
+        rng = example_rng(seed, frame.id, "parallax")
         length = math.exp(rng.uniform(math.log(self.min_m), math.log(self.max_m)))
         direction = rng.standard_normal(3) if self.direction is None else np.asarray(self.direction)
         return length * direction / np.linalg.norm(direction)
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        b = self.baseline_m(sample, seed)
-        view = parallax.sensor_view(sample.depth, sample.valid, sample.intrinsics, b)
-        seen = Sample.from_depth(sample.rgb, view, sample.intrinsics, sample.id)
-        return parallax.to_camera(self.sampler(seen, seed), sample.intrinsics, b)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        b = self.baseline_m(frame, seed)
+        view = parallax.sensor_view(frame.depth, frame.valid, frame.intrinsics, b)
+        seen = Frame.from_depth(frame.rgb, view, frame.intrinsics, frame.id)
+        return parallax.to_camera(self.sampler(seen, seed), frame.intrinsics, b)
 
 
 LIDAR_PRESETS = {"hdl64": LidarSampler.hdl64, "hdl32": LidarSampler.hdl32,
@@ -449,9 +449,9 @@ class Mixture:
         if not self.samplers:
             raise ValueError("Mixture needs at least one sampler")
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        choice = int(example_rng(seed, sample.id, "mixture").integers(len(self.samplers)))
-        return self.samplers[choice](sample, seed)
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        choice = int(example_rng(seed, frame.id, "mixture").integers(len(self.samplers)))
+        return self.samplers[choice](frame, seed)
 
 
 def sampler_from_spec(spec: str) -> SparseSampler:

@@ -32,9 +32,9 @@ from typing import Any
 import numpy as np
 
 from lipjax.data.errors import dataset_error
+from lipjax.data.frame import Frame
 from lipjax.data.hidden import AtWorkingSize, HiddenInput, hide_share
 from lipjax.data.protocols import EvalProtocol, ProtocolView, get_protocol
-from lipjax.data.sample import Sample
 from lipjax.data.sampling import SparseSampler, draws_scan_lines, example_rng, sampler_from_spec, subsample_exact
 from lipjax.interfaces import MIXED_SCENES
 
@@ -49,7 +49,7 @@ NO_PROTOCOL = "none"  # data.protocol="none": frames as they are, even where the
 
 @dataclasses.dataclass(frozen=True)
 class Source:
-    """A data set of (protocol-applied) Samples and the sampler that draws its sparse input."""
+    """A data set of (protocol-applied) Frames and the sampler that draws its sparse input."""
 
     dataset: Any
     sampler: SparseSampler
@@ -64,7 +64,7 @@ class Subset:
     def __len__(self) -> int:
         return len(self.indices)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         return self.dataset[int(self.indices[index])]
 
 
@@ -83,28 +83,28 @@ def tail_split(groups: list[str], split: str, fraction: float = VAL_TAIL_FRACTIO
 @dataclasses.dataclass(frozen=True)
 class FolderInput:
     """Sampler: the folder's own sparse map <root>/sparse/<stem>.png|.npy (PNG: metres = value / depth_scale),
-    optionally sub-sampled to exactly num_points (keyed by the sample id). No protocol: folders train as is."""
+    optionally sub-sampled to exactly num_points (keyed by the frame id). No protocol: folders train as is."""
 
     directory: str
     depth_scale: float | None
     id_prefix: str
     num_points: int | None = None
 
-    def __call__(self, sample: Sample, seed: int = 0) -> np.ndarray:
-        sparse = self.read(sample.id)
-        if sparse.shape != sample.shape:
-            raise dataset_error(f"Sparse input {sparse.shape} and depth {sample.shape} sizes differ",
-                                self._path(sample.id[len(self.id_prefix) + 1:]))
+    def __call__(self, frame: Frame, seed: int = 0) -> np.ndarray:
+        sparse = self.read(frame.id)
+        if sparse.shape != frame.shape:
+            raise dataset_error(f"Sparse input {sparse.shape} and depth {frame.shape} sizes differ",
+                                self._path(frame.id[len(self.id_prefix) + 1:]))
         if self.num_points is not None:
-            sparse = subsample_exact(sparse, self.num_points, example_rng(seed, sample.id))
+            sparse = subsample_exact(sparse, self.num_points, example_rng(seed, frame.id))
         return sparse
 
-    def read(self, sample_id: str) -> np.ndarray:
-        """The whole sparse map (H, W) float32 metres of the frame whose Sample.id is `sample_id`, unchecked against
-        any size (lipjax.data.hidden.HiddenInput reads it at full size for a Sample at its working size)."""
+    def read(self, frame_id: str) -> np.ndarray:
+        """The whole sparse map (H, W) float32 metres of the frame whose Frame.id is `frame_id`, unchecked against
+        any size (lipjax.data.hidden.HiddenInput reads it at full size for a Frame at its working size)."""
         from lipjax.data.folder import read_depth
 
-        path = self._path(sample_id[len(self.id_prefix) + 1:])
+        path = self._path(frame_id[len(self.id_prefix) + 1:])
         return read_depth(path, self.depth_scale if path.suffix.lower() == ".png" else None)
 
     def _path(self, key: str) -> Path:
@@ -148,7 +148,7 @@ def folder_split_root(root: Path, split: str) -> tuple[Path, bool]:
 
 
 def _raw_dataset(data: Any, split: str, render_frames: bool = False) -> tuple[Any, Any]:
-    """(data set of raw Samples of `split`, the object the source's own input comes from or None)."""
+    """(data set of raw Frames of `split`, the object the source's own input comes from or None)."""
     source, root = data.source, data.root
     if source == "synthetic":
         from lipjax.data.synthetic.dataset import EXTRAS, MixedSyntheticDataset, SyntheticDataset

@@ -5,7 +5,7 @@ Layout (as unzipped from the TartanAir release):
     <root>/<env>/<Easy|Hard>/<Pxxx>/image_left/<frame>_left.png
     <root>/<env>/<Easy|Hard>/<Pxxx>/depth_left/<frame>_left_depth.npy     float32 metres
 
-Samples are the raw 480x640 frames; apply protocols.TARTANAIR for the paper's 256x320.
+The loader yields the raw 480x640 frames; apply protocols.TARTANAIR for the paper's 256x320.
 """
 from __future__ import annotations
 
@@ -16,8 +16,8 @@ import numpy as np
 
 from lipjax.data.errors import dataset_error
 from lipjax.data.folder import natural_key, read_rgb
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.data.protocols import TARTANAIR_SPLIT_FRACTIONS, tartanair_split
-from lipjax.data.sample import Intrinsics, Sample
 
 # TartanAir's pinhole camera at 480x640 (same for every environment), pixels.
 TARTANAIR_INTRINSICS = Intrinsics(fx=320.0, fy=320.0, cx=320.0, cy=240.0)
@@ -56,7 +56,7 @@ class TartanAirDataset:
     """TartanAir left-camera frames of one split (trajectory-level 90/5/5, protocols.tartanair_split).
 
     The split is computed over the trajectories found under root (weighted by their frame counts), so use
-    the same full download for every split. Sample.id = "tartanair/<env>/<difficulty>/<Pxxx>/<frame>".
+    the same full download for every split. Frame.id = "tartanair/<env>/<difficulty>/<Pxxx>/<frame>".
 
     Args:
       root: directory holding the environment folders.
@@ -93,7 +93,7 @@ class TartanAirDataset:
     def __len__(self) -> int:
         return len(self.frames)
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         trajectory, frame = self.frames[index]
         base = self.root / trajectory
         rgb_path, depth_path = (base / "image_left" / f"{frame}_left.png",
@@ -104,4 +104,4 @@ class TartanAirDataset:
         if depth.shape != rgb.shape[:2]:
             raise dataset_error(f"RGB {rgb.shape[:2]} and depth {depth.shape} sizes differ", depth_path,
                                 TARTANAIR_LAYOUT)
-        return Sample.from_depth(rgb, depth, self.intrinsics, f"tartanair/{trajectory}/{frame}")
+        return Frame.from_depth(rgb, depth, self.intrinsics, f"tartanair/{trajectory}/{frame}")

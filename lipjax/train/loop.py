@@ -30,9 +30,9 @@ from tqdm.auto import tqdm
 
 from lipjax import model_io
 from lipjax.train.checkpoint import CheckpointManager, to_host
+from lipjax.data.frame import Batch
 from lipjax.data.pipeline import BatchIterator, StepBatches, TrainLoader, make_data_mesh, shard_batch
 from lipjax.data.pipeline import validation_batches as source_validation_batches
-from lipjax.data.sample import Batch
 from lipjax.data.sources import open_source
 from lipjax.inference import compiled_apply
 from lipjax.metrics import MetricAggregator, compute_metrics

@@ -38,8 +38,8 @@ its rooms (`far_view.add_far_view`): a room's frame then holds depths of 1-80 m,
 Conventions:
   * Camera frame: x right, y down, z forward (OpenCV). Pixel (row v, column u) has its centre at (u, v);
     its ray is ((u - cx) / fx, (v - cy) / fy, 1) in the camera frame.
-  * `Sample.depth` is z-depth (distance along the optical axis, as in NYU and KITTI), not the ray length:
-    float32 metres, 0 = invalid, `Sample.valid = depth > 0`.
+  * `Frame.depth` is z-depth (distance along the optical axis, as in NYU and KITTI), not the ray length:
+    float32 metres, 0 = invalid, `Frame.valid = depth > 0`.
   * World frame (exposed through `SceneInfo` from `render_with_info`): y up, floor / road on the plane
     y = 0, x to the right of and z ahead of an unrotated camera. `SceneInfo.camera_to_world` maps
     camera-frame points to world points (its rotation has determinant -1: camera y is down, world y up).
@@ -64,7 +64,7 @@ Per-primitive numpy calls are batched where the arithmetic allows it without cha
 (small parts' camera rays, box and cylinder surfaces, shadow rays: one call per primitive kind); textures
 (one call per material) and scene construction (Python) remain per object.
 
-Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `focal_factor`, `sample_id`,
+Public API: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `focal_factor`, `frame_id`,
 `SceneInfo`, `LABELS` and the constants in `__all__`; for a frame drawn another way (lipjax.data.rendered: a window
 of the camera) its parts: `frame_rngs` (a frame's two random streams), `build_scene(kind, rng)` (its `Scene`),
 `render_scene` (the scene through a camera), `check_kind_split`, `check_size`, `check_focal_range`,
@@ -109,7 +109,7 @@ from lipjax.data.synthetic.dataset import (
     intrinsics_for,
     render,
     render_with_info,
-    sample_id,
+    frame_id,
 )
 from lipjax.data.synthetic.far_view import add_far_view
 from lipjax.data.synthetic.renderer import render_scene
@@ -146,5 +146,5 @@ __all__ = [
     "render",
     "render_scene",
     "render_with_info",
-    "sample_id",
+    "frame_id",
 ]

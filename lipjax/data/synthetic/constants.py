@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 
 SYNTHETIC_KINDS = ("indoor", "outdoor")
 SPLITS = ("train", "val", "test")

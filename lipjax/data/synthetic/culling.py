@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.data.synthetic.arrays import _ranges
 
 _NEAR = 0.02  # near plane used for screen-space culling (metres)

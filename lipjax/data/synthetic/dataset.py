@@ -1,4 +1,4 @@
-"""The public entry points: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `sample_id`.
+"""The public entry points: `render`, `render_with_info`, `SyntheticDataset`, `intrinsics_for`, `frame_id`.
 
 Argument checks (`check_kind_split`, `check_size`), per-frame random streams (`frame_rngs`) and sample ids live here;
 a frame's scene comes from `scenes.build_scene` and is drawn by `renderer.render_scene`.
@@ -12,7 +12,7 @@ from typing import Iterator
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics, Sample
+from lipjax.data.frame import Frame, Intrinsics
 from lipjax.interfaces import MIXED_SCENES
 from lipjax.data.synthetic.constants import (
     DEFAULT_HEIGHT,
@@ -34,7 +34,7 @@ from lipjax.data.synthetic.build import build_scene
 
 @dataclasses.dataclass(frozen=True)
 class SceneInfo:
-    """What was rendered, beyond the Sample: for tests, debugging and visualisation.
+    """What was rendered, beyond the Frame: for tests, debugging and visualisation.
 
     Attributes:
       kind: "indoor" or "outdoor".
@@ -122,8 +122,8 @@ def intrinsics_for(kind: str, height: int = DEFAULT_HEIGHT, width: int = DEFAULT
     return ref.cropped((h0 - ch) / 2, (w0 - cw) / 2).resized(height / ch, width / cw)
 
 
-def sample_id(kind: str, split: str, index: int) -> str:
-    """The Sample.id of a synthetic frame, e.g. "synthetic/indoor/val/000042"."""
+def frame_id(kind: str, split: str, index: int) -> str:
+    """The Frame.id of a synthetic frame, e.g. "synthetic/indoor/val/000042"."""
     return f"synthetic/{kind}/{split}/{index:06d}"
 
 
@@ -196,7 +196,7 @@ def render_with_info(
     kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
     focal_range: tuple[float, float] = (1.0, 1.0), reflection: Reflection | None = None,
     clutter: np.random.Generator | None = None, foliage: np.random.Generator | None = None,
-) -> tuple[Sample, SceneInfo]:
+) -> tuple[Frame, SceneInfo]:
     """Renders frame `index` of (kind, split) at height x width; also returns the camera pose and labels.
 
     `focal_range`: the camera's focal lengths are intrinsics_for(kind, H, W)'s times `focal_factor` (principal
@@ -228,16 +228,16 @@ def render_with_info(
         intr = dataclasses.replace(intr, fx=intr.fx * f, fy=intr.fy * f)
     with np.errstate(all="ignore"):
         rgb, depth, labels = render_scene(scene, height, width, intr, noise_rng, reflection)
-    sample = Sample.from_depth(rgb, depth, intr, sample_id(kind, split, index))
+    frame = Frame.from_depth(rgb, depth, intr, frame_id(kind, split, index))
     pose = np.eye(4)
     pose[:3, :3] = scene.cam_R
     pose[:3, 3] = scene.cam_pos
-    return sample, SceneInfo(kind, pose, float(scene.cam_pos[1]), labels)
+    return frame, SceneInfo(kind, pose, float(scene.cam_pos[1]), labels)
 
 
 def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, width: int = DEFAULT_WIDTH,
-           focal_range: tuple[float, float] = (1.0, 1.0)) -> Sample:
-    """Renders frame `index` of the synthetic (kind, split) set as a Sample.
+           focal_range: tuple[float, float] = (1.0, 1.0)) -> Frame:
+    """Renders frame `index` of the synthetic (kind, split) set as a Frame.
 
     Args:
       kind: "indoor" or "outdoor".
@@ -246,7 +246,7 @@ def render(kind: str, split: str, index: int, height: int = DEFAULT_HEIGHT, widt
       height, width: render size in pixels (the scene does not depend on it).
       focal_range: (lo, hi) factors on the focal length, one drawn per frame (`render_with_info`).
     Returns:
-      Sample with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
+      Frame with rgb (H, W, 3) uint8, depth (H, W) float32 z-depth in metres (0 = invalid: sky, or farther
       than RENDER_FAR_CLIP_M), valid = depth > 0, intrinsics = intrinsics_for(kind, H, W) (focal lengths times
       the frame's `focal_factor`), id = "synthetic/{kind}/{split}/{index:06d}".
     """
@@ -290,7 +290,7 @@ class SyntheticDataset:
     def __len__(self) -> int:
         return self.size
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         index = _check_index(index)
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for SyntheticDataset({self.kind!r}, {self.split!r}) "
@@ -299,13 +299,13 @@ class SyntheticDataset:
                                 clutter=_drawn(clutter_rng, self.split, index, self.clutter_prob),
                                 foliage=_drawn(foliage_rng, self.split, index, self.foliage_prob))[0]
 
-    def __iter__(self) -> Iterator[Sample]:
+    def __iter__(self) -> Iterator[Frame]:
         for i in range(self.size):
             yield self[i]
 
     @property
     def intrinsics(self) -> Intrinsics:
-        """The reference camera at this size (a frame's own, with its focal factor, is its Sample.intrinsics)."""
+        """The reference camera at this size (a frame's own, with its focal factor, is its Frame.intrinsics)."""
         return intrinsics_for(self.kind, self.height, self.width)
 
     def __repr__(self) -> str:
@@ -320,7 +320,7 @@ class MixedSyntheticDataset:
     dataset[2 i + 1] == render("outdoor", split, i, H, W).
 
     Both kinds are rendered at the same height x width (so that they batch together); the outdoor camera keeps
-    KITTI's vertical field of view (`intrinsics_for`). Sample ids are the per-kind ones, so a sampler draws the same
+    KITTI's vertical field of view (`intrinsics_for`). Frame ids are the per-kind ones, so a sampler draws the same
     points from a frame here as from the single-kind set.
 
     far_view_prob: the probability that a room shows a far view through a window (lipjax.data.synthetic.far_view):
@@ -344,7 +344,7 @@ class MixedSyntheticDataset:
     def __len__(self) -> int:
         return self.size
 
-    def __getitem__(self, index: int) -> Sample:
+    def __getitem__(self, index: int) -> Frame:
         index = _check_index(index)
         if index >= self.size:
             raise _IndexOutOfRange(f"index {index} out of range for MixedSyntheticDataset({self.split!r}) of size "

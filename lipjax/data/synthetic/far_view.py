@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lipjax.data.sample import Sample
+from lipjax.data.frame import Frame
 
 WINDOW_HEIGHT = (0.2, 0.45)  # window height / frame height
 WINDOW_WIDTH = (0.15, 0.4)  # window width / frame width
@@ -39,7 +39,7 @@ def far_view_box(shape: tuple[int, int], rng: np.random.Generator) -> tuple[int,
     return t, l, h, w, t_view, l_view
 
 
-def add_far_view(room: Sample, view: Sample, rng: np.random.Generator) -> Sample:
+def add_far_view(room: Frame, view: Frame, rng: np.random.Generator) -> Frame:
     """`room` with a window onto `view` (the module docstring); the room's intrinsics and id are kept.
 
     Raises:
@@ -51,4 +51,4 @@ def add_far_view(room: Sample, view: Sample, rng: np.random.Generator) -> Sample
     rgb, depth = room.rgb.copy(), np.where(room.valid, room.depth, 0.0).astype(np.float32)
     rgb[t:t + h, l:l + w] = view.rgb[tv:tv + h, lv:lv + w]
     depth[t:t + h, l:l + w] = np.where(view.valid, view.depth, 0.0)[tv:tv + h, lv:lv + w]
-    return Sample.from_depth(rgb, depth, room.intrinsics, room.id)
+    return Frame.from_depth(rgb, depth, room.intrinsics, room.id)

@@ -7,7 +7,7 @@ import dataclasses
 import cv2
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.data.synthetic.arrays import _cols, _set_cols
 from lipjax.data.synthetic.camera import _camera_image
 from lipjax.data.synthetic.constants import _F32, _FLOOR, _ROAD, _TERRAIN

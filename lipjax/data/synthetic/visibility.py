@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from lipjax.data.sample import Intrinsics
+from lipjax.data.frame import Intrinsics
 from lipjax.data.synthetic.arrays import _cols
 from lipjax.data.synthetic.constants import _F32
 from lipjax.data.synthetic.culling import _rect_pixels, _rects

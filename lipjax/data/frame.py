@@ -1,4 +1,4 @@
-"""The one data type every loader yields, and batching of samples into arrays.
+"""The one data type every loader yields, and batching of frames into arrays.
 
 Units: depth in metres everywhere (0 = invalid / no measurement); intrinsics in pixels.
 """
@@ -36,7 +36,7 @@ class Intrinsics:
 
 
 @dataclasses.dataclass(frozen=True)
-class Sample:
+class Frame:
     """One RGB-D frame.
 
     Attributes:
@@ -55,19 +55,19 @@ class Sample:
 
     def __post_init__(self):
         if self.rgb.dtype != np.uint8 or self.rgb.ndim != 3 or self.rgb.shape[2] != 3:
-            raise ValueError(f"Sample {self.id!r}: rgb must be uint8 (H, W, 3), got {self.rgb.dtype} {self.rgb.shape}")
+            raise ValueError(f"Frame {self.id!r}: rgb must be uint8 (H, W, 3), got {self.rgb.dtype} {self.rgb.shape}")
         if self.depth.dtype != np.float32 or self.depth.shape != self.rgb.shape[:2]:
             raise ValueError(
-                f"Sample {self.id!r}: depth must be float32 (H, W) = {self.rgb.shape[:2]} in metres, "
+                f"Frame {self.id!r}: depth must be float32 (H, W) = {self.rgb.shape[:2]} in metres, "
                 f"got {self.depth.dtype} {self.depth.shape}"
             )
         if self.valid.dtype != np.bool_ or self.valid.shape != self.depth.shape:
-            raise ValueError(f"Sample {self.id!r}: valid must be bool {self.depth.shape}, "
+            raise ValueError(f"Frame {self.id!r}: valid must be bool {self.depth.shape}, "
                              f"got {self.valid.dtype} {self.valid.shape}")
 
     @classmethod
-    def from_depth(cls, rgb: np.ndarray, depth: np.ndarray, intrinsics: Intrinsics, id: str) -> "Sample":
-        """Builds a Sample, deriving `valid` from depth (> 0 and finite) and zeroing invalid depth."""
+    def from_depth(cls, rgb: np.ndarray, depth: np.ndarray, intrinsics: Intrinsics, id: str) -> "Frame":
+        """Builds a Frame, deriving `valid` from depth (> 0 and finite) and zeroing invalid depth."""
         depth = np.asarray(depth, dtype=np.float32)
         valid = np.isfinite(depth) & (depth > 0)
         return cls(np.ascontiguousarray(rgb, dtype=np.uint8), np.where(valid, depth, 0).astype(np.float32), valid,
