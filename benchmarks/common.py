@@ -5,7 +5,7 @@ synthetic suite's settings with the ratio to the linear fill, and the timing yar
                   copied), the loaders of its data sets (`load_nyu`, `load_kitti`, `load_middlebury`,
                   `load_lingbot`; `load_real` with the paper's protocols) and the inputs every real-frame script
                   draws on them (`frames_and_inputs`: 200 uniform points indoors; the HDL-64 pattern and 30 % of the
-                  valid pixels on KITTI, seed 0);
+                  valid pixels on KITTI, seed 0) and `hide_points` (a fifth of an input's points held out);
   the suite       the synthetic test settings of benchmarks/generalisation.py (`SETTINGS`, `frames`) and the RMSE
                   ratio to the Delaunay linear fill on the unsampled valid pixels (`ratio_to_linear`,
                   `ratios_to_linear`, `geometric_mean`);
@@ -26,7 +26,7 @@ import numpy as np
 
 from lipjax.data import protocols
 from lipjax.data.frame import Frame, Intrinsics
-from lipjax.data.sampling import LidarSampler, UniformSampler, sampler_from_spec
+from lipjax.data.sampling import LidarSampler, UniformSampler, example_rng, sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.data.synthetic.dataset import MixedSyntheticDataset
 from lipjax.inference import CROSS_CHECK, complete_frame
@@ -41,6 +41,7 @@ OUTDOOR_RANGE_M = (0.0, protocols.EVAL_MAX_DEPTH_OUTDOOR_M)
 INDOOR_POINTS = 200  # uniform points on every indoor real frame
 KITTI_FRACTION = 0.3  # of the valid pixels, the second KITTI input
 GREY = 128  # the uniform grey image of the "grey" runs (the depth-only part of the prior)
+HIDDEN_FRACTION = 0.2  # of an input's points, hidden at random (`hide_points`)
 
 
 def read_rgb(path: str) -> np.ndarray:
@@ -132,6 +133,18 @@ def indoor_frames(root: str) -> list[Frame]:
     """The 12 shared indoor frames at native size: NYU v2 (3), Middlebury Motorcycle (1), lingbot (8)."""
     indoor = load_nyu(os.path.join(root, "nyu_v2")) + load_middlebury(os.path.join(root, "middlebury2014_motorcycle"))
     return indoor + load_lingbot(os.path.join(root, "lingbot_rgbd"))
+
+
+def hide_points(frame: Frame, sparse: np.ndarray, fraction: float = HIDDEN_FRACTION,
+                seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """(input without the hidden points, hidden mask): round(fraction x points) of the input's points, drawn by
+    `example_rng(seed, frame.id, "hidden")`."""
+    idx = np.flatnonzero(sparse > 0)
+    chosen = example_rng(seed, frame.id, "hidden").choice(idx, int(round(fraction * idx.size)), replace=False)
+    hidden = np.zeros(sparse.size, bool)
+    hidden[chosen] = True
+    hidden = hidden.reshape(sparse.shape)
+    return np.where(hidden, 0.0, sparse).astype(np.float32), hidden
 
 
 def frames_and_inputs(root: str) -> list[tuple[str, Frame, np.ndarray, str]]:

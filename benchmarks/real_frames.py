@@ -27,7 +27,7 @@ of the default path (`lipjax.complete`, with `--model` and `--flip` as above), `
 and MAE (m) and the default path's ratio to linear:
 
     dense ground truth   the whole input; scored on the unsampled valid ground-truth pixels (the table above)
-    hidden points        HIDDEN_FRACTION (20 %) of the input's points, drawn at random by
+    hidden points        benchmarks.common.HIDDEN_FRACTION (20 %) of the input's points, drawn at random by
                          `example_rng(0, frame id, "hidden")` (seed 0), removed from the input; the rest (80 %)
                          completed, scored on the hidden points alone (their depth: the ground truth there)
     hidden beams         every HIDDEN_BEAM_EVERY-th (4th) scan line of the input removed: the beams present in the
@@ -49,9 +49,9 @@ import time
 
 import numpy as np
 
-from benchmarks.common import GREY, REALDATA, frames_and_inputs, geometric_mean, load_kitti
+from benchmarks.common import GREY, REALDATA, frames_and_inputs, geometric_mean, hide_points, load_kitti
 from lipjax.data.frame import Frame
-from lipjax.data.sampling import LidarSampler, example_rng
+from lipjax.data.sampling import LidarSampler
 from lipjax.inference import complete_at, complete_frame, frame_size
 from lipjax.inputs import is_lidar_pattern
 from lipjax.methods import complete, get_completer
@@ -59,7 +59,6 @@ from lipjax.resolution import sample_spacing_px, working_size
 
 SWEEP_TARGETS_PX = (6.0, 8.0, 11.0, 16.0, 22.0, 32.0, 1e9)
 KITTI_LIDAR = LidarSampler.hdl64()  # the KITTI input's pattern (frames_and_inputs)
-HIDDEN_FRACTION = 0.2  # of the input's points, hidden at random
 HIDDEN_BEAM_EVERY = 4  # every 4th scan line hidden
 HIDDEN_METHODS = ("linear", "ip_basic")
 CHECKS = ("dense ground truth", "hidden points", "hidden beams")
@@ -91,18 +90,6 @@ def beam_index(frame: Frame, sparse: np.ndarray, sampler: LidarSampler = KITTI_L
     if np.any((sparse > 0) & (label < 0)):
         raise ValueError(f"{frame.id}: input points off the valid ground truth, so off the sampler's pixels")
     return label
-
-
-def hide_points(frame: Frame, sparse: np.ndarray, fraction: float = HIDDEN_FRACTION,
-                seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
-    """(input without the hidden points, hidden mask): round(fraction x points) of the input's points, drawn by
-    `example_rng(seed, frame.id, "hidden")`."""
-    idx = np.flatnonzero(sparse > 0)
-    chosen = example_rng(seed, frame.id, "hidden").choice(idx, int(round(fraction * idx.size)), replace=False)
-    hidden = np.zeros(sparse.size, bool)
-    hidden[chosen] = True
-    hidden = hidden.reshape(sparse.shape)
-    return np.where(hidden, 0.0, sparse).astype(np.float32), hidden
 
 
 def hide_beams(beams: np.ndarray, sparse: np.ndarray,
