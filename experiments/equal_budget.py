@@ -19,9 +19,10 @@ Stages, each skipped when its output exists, so the study continues across sessi
 run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
 (experiments/study_scores, committed: a new machine goes on from them); runs, checkpoints and models stay in --root
 (runs/study, not committed) except the run in progress at a session's end, whose workdir may be committed under
-experiments/warm_starts/study/<scene>/<trunk>/seed<k> to be continued from:
-  1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS
-     (seed 0, the validation split: never the test split); the same small budget for every trunk;
+experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k> to be continued from:
+  1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS and,
+     while the best is the grid's edge, rates beyond it (`next_rate`; seed 0, the validation split: never the test
+     split); the same small budget for every trunk;
   2. per scene, per seed: each trunk to each budget of its curve (--curve points <= --images for every seed, all of
      --curve for seed 0), its model exported and scored on the test split at each; each branch at each budget;
   3. the report (also --report): docs/results/equal_budget.json, docs/results/equal_budget.md, the data-efficiency
@@ -33,6 +34,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import math
 import pathlib
 import shutil
 import sys
@@ -49,6 +51,9 @@ from lipjax.utils import enable_compilation_cache, written_whole
 PROG = f"python -m {__spec__.name}"
 
 TUNE_LRS = (2e-4, 5e-4, 1.25e-3)  # x2.5 steps around the configs' 5e-4; the same three for every trunk
+# Where the best of TUNE_LRS is its largest (smallest), tuning goes on one x TUNE_FACTOR step beyond it while the best
+# is the edge of what was tried, at most TUNE_EXTENSIONS steps past the grid (docs/decisions/0028, amended 2026-12-06)
+TUNE_FACTOR, TUNE_EXTENSIONS = 2.5, 2
 TEST_INPUT = {"indoor": "uniform:200", "outdoor": "lidar:hdl64"}  # Tables I and II
 TEST_LIMIT = {"indoor": 100, "outdoor": 50}  # the tables' default frame counts
 DEFAULT_SEEDS = {"indoor": (0, 1, 2), "outdoor": (0,)}
@@ -103,17 +108,31 @@ class Study:
 
 # ---- stage 1: tuning -------------------------------------------------------------------------------------------
 
+def next_rate(rmse: dict[float, float]) -> float | None:
+    """The learning rate tuning tries next, given {rate: validation RMSE} of the rates tried so far (None: done):
+    TUNE_LRS in order; then, while the best (non-finite RMSE counting as the worst) is the largest rate tried, one
+    TUNE_FACTOR step above it, or the smallest, one below it, at most TUNE_EXTENSIONS steps past TUNE_LRS."""
+    for lr in TUNE_LRS:
+        if lr not in rmse:
+            return lr
+    best = _best(rmse)
+    top, bottom = TUNE_LRS[-1] * TUNE_FACTOR ** TUNE_EXTENSIONS, TUNE_LRS[0] / TUNE_FACTOR ** TUNE_EXTENSIONS
+    if best == max(rmse) and best < top * (1 - 1e-9):
+        return float(f"{best * TUNE_FACTOR:.6g}")
+    if best == min(rmse) and best > bottom * (1 + 1e-9):
+        return float(f"{best / TUNE_FACTOR:.6g}")
+    return None
+
+
 def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) -> float:
-    """The trunk's learning rate: the lowest validation RMSE after tune_images images of seed 0 among TUNE_LRS
-    (cached in <scores>/<scene>/tuning.json with every rate's score)."""
+    """The trunk's learning rate: the lowest validation RMSE after tune_images images of seed 0 among the rates
+    `next_rate` asks for (cached in <scores>/<scene>/tuning.json with every rate's score)."""
     from lipjax.train.loop import evaluate_params, train, validation_batches
 
     path = study.scores_dir(scene) / "tuning.json"
     table = json.loads(path.read_text()) if path.exists() else {}
     scores = table.get(trunk, {})
-    for lr in TUNE_LRS:
-        if f"{lr:g}" in scores:
-            continue
+    while (lr := next_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})) is not None:
         config = trunk_config(trunk, scene, learning_rate=lr, seed=0, steps=study.tune_images // BATCH,
                               tiny=study.tiny)
         config = with_workers(dataclasses.replace(config, eval_every=config.g_steps), study.workers)
@@ -123,7 +142,12 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
         table[trunk] = scores
         _write_json(path, table)
         print(f"[study] {scene} {trunk} lr {lr:g}: val rmse_m={val['rmse_m']:.4f}", flush=True)
-    return float(min(scores, key=lambda k: scores[k]["val_rmse_m"]))
+    return _best({float(k): v["val_rmse_m"] for k, v in scores.items()})
+
+
+def _best(rmse: dict[float, float]) -> float:
+    """The rate of the lowest RMSE, a non-finite one (a diverged run) counting as the worst."""
+    return min(rmse, key=lambda r: rmse[r] if math.isfinite(rmse[r]) else math.inf)
 
 
 def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
@@ -144,11 +168,12 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
     lr = tuned_learning_rate(study, scene, trunk, progress)
     budgets = [b for b in study.budgets_for(scene, seed) if b <= upto]
     wanted_branches = [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    drop_stale_scores(study, scene, [trunk, *wanted_branches], seed, lr)
     stops = sorted({*budgets, *(b - study.adv_images for b in budgets if wanted_branches)})
     final = max(study.budgets_for(scene, seed))  # the run's length is fixed by its seed's largest budget
     config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
                                        tiny=study.tiny), study.workers)
-    workdir = trunk_workdir(study, scene, trunk, seed)
+    workdir = trunk_workdir(study, scene, trunk, lr, seed)
     for images in stops:
         if not _needed(study, scene, trunk, seed, images, budgets, wanted_branches):
             continue
@@ -160,17 +185,30 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
                                  "added after the run went by it cannot be scored; start another --root")
             export(config, state, model, {"learning_rate": lr, "schedule": config.schedule, "data": scene})
         if images in budgets and not result_path(study, scene, trunk, seed, images).exists():
-            score(study, scene, trunk, seed, images, model)
+            score(study, scene, trunk, seed, images, model, lr)
     for method in wanted_branches:
         for images in budgets:
-            run_branch(study, scene, method, config, seed, images, progress)
+            run_branch(study, scene, method, config, workdir, seed, images, progress)
 
 
-def trunk_workdir(study: Study, scene: str, trunk: str, seed: int) -> pathlib.Path:
-    """The run's workdir in --root; on a machine without it, a copy of the one committed under study.warm_starts
-    (the run that was in progress when a session ended), if any."""
-    workdir = study.scene_dir(scene) / trunk / f"seed{seed}"
-    committed = None if study.warm_starts is None else study.warm_starts / scene / trunk / f"seed{seed}"
+def drop_stale_scores(study: Study, scene: str, methods: list[str], seed: int, lr: float) -> None:
+    """Removes the scores of `methods` and `seed` made at a learning rate other than the trunk's tuned `lr` (tuning
+    that went past its grid after they were made): they are made again at `lr`."""
+    for method in methods:
+        for path in study.scores_dir(scene).glob(f"{method}-seed{seed}-*.json"):
+            made_at = json.loads(path.read_text()).get("learning_rate")
+            if made_at != lr:
+                path.unlink()
+                print(f"[study] {path} was made at learning rate {made_at}, not the tuned {lr:g}: made again",
+                      flush=True)
+
+
+def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) -> pathlib.Path:
+    """The run's workdir in --root (one per learning rate); on a machine without it, a copy of the one committed
+    under study.warm_starts (the run that was in progress when a session ended), if any."""
+    run = pathlib.Path(scene) / trunk / f"lr{lr:g}" / f"seed{seed}"
+    workdir = study.root / run
+    committed = None if study.warm_starts is None else study.warm_starts / run
     if not workdir.exists() and committed is not None and committed.is_dir():
         shutil.copytree(committed, workdir)
         print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
@@ -188,25 +226,28 @@ def _needed(study: Study, scene: str, trunk: str, seed: int, images: int, budget
                for m in branches)
 
 
-def run_branch(study: Study, scene: str, method: str, trunk: TrainConfig, seed: int, images: int,
-               progress: bool) -> None:
-    """LIP+AD `method` at `images`: from its trunk's model at images - adv_images (experiments/configs/study.py)."""
+def run_branch(study: Study, scene: str, method: str, trunk: TrainConfig, trunk_dir: pathlib.Path, seed: int,
+               images: int, progress: bool) -> None:
+    """LIP+AD `method` at `images`: from its trunk's model (run in `trunk_dir`) at images - adv_images
+    (experiments/configs/study.py), at the trunk's learning rate."""
     from lipjax.train.run import run
 
     if result_path(study, scene, method, seed, images).exists():
         return
-    start = study.scene_dir(scene) / BRANCHES[method][0] / f"seed{seed}" / "models" / str(images - study.adv_images)
+    start = trunk_dir / "models" / str(images - study.adv_images)
     config = branch_config(method, trunk, str(start), study.adv_images)
-    workdir = study.scene_dir(scene) / method / f"seed{seed}" / str(images)
+    lr = trunk.learning_rate
+    workdir = study.scene_dir(scene) / method / f"lr{lr:g}" / f"seed{seed}" / str(images)
     model = workdir / "model"
     if not model.with_suffix(".msgpack").exists():
         run(config, workdir, export=model, progress=progress)
-    score(study, scene, method, seed, images, model)
+    score(study, scene, method, seed, images, model, lr)
 
 
-def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path) -> dict:
-    """Scores `model` on the scene's test split (Table I / II input, protocol and frames), per frame, and for a LIP
-    model at every iteration count K (Fig. 4a); writes <scores>/<scene>/<method>-seed<seed>-<images>.json."""
+def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path, lr: float) -> dict:
+    """Scores `model` (trained at learning rate `lr`) on the scene's test split (Table I / II input, protocol and
+    frames), per frame, and for a LIP model at every iteration count K (Fig. 4a); writes
+    <scores>/<scene>/<method>-seed<seed>-<images>.json."""
     from lipjax.evaluate import evaluate
     from lipjax.inference import load_model
     from lipjax.model import LIPConfig
@@ -221,7 +262,7 @@ def score(study: Study, scene: str, method: str, seed: int, images: int, model: 
         per_k[k] = r
     full = per_k[max(ks)] if ks else evaluate(completer, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                               max_depth_m=protocol.max_depth_m, limit=limit, progress=False)
-    doc = {"method": method, "scene": scene, "seed": seed, "images": images,
+    doc = {"method": method, "scene": scene, "seed": seed, "images": images, "learning_rate": lr,
            "images_seen": completer.metadata.get("images_seen"), "model": str(model),
            "rmse_m": full.metrics["rmse_m"], "mae_m": full.metrics["mae_m"], "metrics": full.metrics,
            "per_image": [{"id": p["id"], "rmse_m": p["rmse_m"], "mae_m": p["mae_m"]} for p in full.per_image],

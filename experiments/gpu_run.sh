@@ -41,6 +41,6 @@ echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
 python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" --results "$ROOT/report" --report \
   --images "$IMAGES" $ARGS >> "$LOG" 2>&1
 tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
-(cd "$ROOT" && ls -d */*/seed*/models/"$IMAGES".* */*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
+(cd "$ROOT" && ls -d */*/lr*/seed*/models/"$IMAGES".* */*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
   | split -b 15M - "$OUT/models.tgz.")
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

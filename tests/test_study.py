@@ -43,16 +43,42 @@ def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
 
 
 def test_a_run_committed_to_go_on_from_is_copied_to_a_machine_without_it(tmp_path, capsys):
-    committed = tmp_path / "warm" / "indoor" / "unet" / "seed1"
+    committed = tmp_path / "warm" / "indoor" / "unet" / "lr0.00125" / "seed1"
     (committed / "checkpoints" / "500").mkdir(parents=True)
     (committed / "run.json").write_text("{}")
     s = study(tmp_path, warm_starts=tmp_path / "warm")
-    workdir = equal_budget.trunk_workdir(s, "indoor", "unet", 1)
+    assert not equal_budget.trunk_workdir(s, "indoor", "unet", 5e-4, 1).exists()  # another rate: another run
+    workdir = equal_budget.trunk_workdir(s, "indoor", "unet", 1.25e-3, 1)
     assert (workdir / "checkpoints" / "500").is_dir() and (workdir / "run.json").read_text() == "{}"
     assert "continuing from" in capsys.readouterr().out
     (workdir / "run.json").write_text("moved on")  # a workdir that exists is never replaced
-    assert (equal_budget.trunk_workdir(s, "indoor", "unet", 1) / "run.json").read_text() == "moved on"
-    assert not equal_budget.trunk_workdir(study(tmp_path, warm_starts=None), "indoor", "unet", 2).exists()
+    assert (equal_budget.trunk_workdir(s, "indoor", "unet", 1.25e-3, 1) / "run.json").read_text() == "moved on"
+    assert not equal_budget.trunk_workdir(study(tmp_path, warm_starts=None), "indoor", "unet", 1.25e-3, 2).exists()
+
+
+def test_tuning_goes_past_the_grid_while_its_edge_is_best_and_at_most_two_steps():
+    grid = dict.fromkeys(equal_budget.TUNE_LRS, 1.0)
+    assert equal_budget.next_rate({}) == 2e-4 and equal_budget.next_rate({2e-4: 1.0}) == 5e-4
+    assert equal_budget.next_rate({**grid, 5e-4: 0.5}) is None  # the best inside the grid: done
+    assert equal_budget.next_rate({**grid, 1.25e-3: 0.5}) == 3.125e-3  # the top is best: one step up
+    assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: 0.4}) == 7.8125e-3
+    assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: 0.4, 7.8125e-3: 0.3}) is None  # two steps past
+    assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: 0.6}) is None  # the step up lost: 1.25e-3
+    assert equal_budget.next_rate({**grid, 2e-4: 0.5}) == 8e-5  # the bottom is best: one step down
+    assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) is None  # diverged: the worst
+    assert equal_budget._best({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) == 1.25e-3
+
+
+def test_scores_made_at_another_rate_than_the_tuned_one_are_dropped(tmp_path, capsys):
+    s = study(tmp_path)
+    folder = s.scores_dir("indoor")
+    folder.mkdir(parents=True)
+    for name, lr in (("unet-seed0-16", 1.25e-3), ("unet-seed0-32", 3.125e-3), ("unet-seed1-16", 1.25e-3),
+                     ("cspn-seed0-16", 1.25e-3)):
+        (folder / f"{name}.json").write_text(json.dumps({"learning_rate": lr}))
+    equal_budget.drop_stale_scores(s, "indoor", ["unet"], 0, 3.125e-3)
+    assert sorted(p.stem for p in folder.glob("*.json")) == ["cspn-seed0-16", "unet-seed0-32", "unet-seed1-16"]
+    assert "not the tuned 0.003125: made again" in capsys.readouterr().out
 
 
 def test_a_branch_reads_its_budget_of_images_on_a_stream_of_its_own():
@@ -120,6 +146,7 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
 
 def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(equal_budget, "TUNE_LRS", (5e-4, 1e-3))  # two rates: a choice, in fewer compiles
+    monkeypatch.setattr(equal_budget, "TUNE_EXTENSIONS", 0)  # none past them (next_rate's own test)
     args = ["--tiny", "--root", str(tmp_path / "study"), "--scores", str(tmp_path / "scores"), "--results",
             str(tmp_path / "report"), "--scene", "indoor",
             "--seeds", "0", "--images", "96", "--curve", "48,96", "--tune-images", "16", "--adv-images", "40",
