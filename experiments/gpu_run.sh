@@ -5,10 +5,11 @@
 #   OUT=/tmp/out [BUDGET_S=560] [WORKERS=14] [IMAGES=30000] [STUDY_ARGS="--scene indoor --seeds 1,2"] [WHEELS=DIR] \
 #       bash experiments/gpu_run.sh
 #
-# Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops) in
-# runs/study, going on from the committed tuning and scores (experiments/study_scores, in the working tree that
-# travels), then packs what it finished into OUT: log.txt, scores.tgz (the tuning and scores, and the report) and the
-# exported models at the budget IMAGES, models.tgz.* (15 MB parts). Back on the CPU machine:
+# Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
+# later if anything still runs) in runs/study, going on from the committed tuning and scores
+# (experiments/study_scores, in the working tree that travels), then packs what it finished into OUT: log.txt,
+# scores.tgz (the tuning and scores, and the report) and the exported models at the budget IMAGES, models.tgz.*
+# (15 MB parts). Back on the CPU machine:
 #
 #   tar xzf scores.tgz && cat models.tgz.* | tar xzf - -C runs/study      # then commit experiments/study_scores
 #
@@ -35,7 +36,7 @@ mkdir -p "$OUT" "$ROOT"
 . "$(dirname "$0")/gpu_env.sh"
 LEFT=$(( BUDGET_S - ($(date +%s) - T0) - RESERVE_S ))
 echo "== the study for $LEFT s: $ARGS" >> "$LOG"
-timeout -s TERM "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" \
+timeout -s TERM -k 30 "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" \
   --results "$ROOT/report" --workers "$WORKERS" --images "$IMAGES" --no-progress $ARGS >> "$LOG" 2>&1
 echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
 python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" --results "$ROOT/report" --report \

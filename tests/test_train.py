@@ -413,14 +413,16 @@ def test_a_second_signal_exits_at_once_and_the_handlers_are_restored():
     (save_first=False) exits on the first SIGTERM and leaves SIGINT to Python."""
     before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
     for signum, second in ((signal.SIGINT, KeyboardInterrupt), (signal.SIGTERM, SystemExit)):
-        with loop._signals_as_exit(save_first=True) as stop:
-            os.kill(os.getpid(), signum)
-            time.sleep(0.01)  # the handler runs between bytecodes
-            assert stop.is_set() and stop.signum == signum
-            with pytest.raises(second) as info:
+        with pytest.raises(SystemExit) as ended:
+            with loop._signals_as_exit(save_first=True) as stop:
                 os.kill(os.getpid(), signum)
-                time.sleep(1)
-            assert signum == signal.SIGINT or info.value.code == 143
+                time.sleep(0.01)  # the handler runs between bytecodes
+                assert stop.is_set() and stop.signum == signum
+                with pytest.raises(second) as info:
+                    os.kill(os.getpid(), signum)
+                    time.sleep(1)
+                assert signum == signal.SIGINT or info.value.code == 143
+        assert ended.value.code == 128 + signum  # a run that ended after the signal still stops the process
         assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
     with loop._signals_as_exit(save_first=False) as stop:
         assert signal.getsignal(signal.SIGINT) == before[0]
@@ -428,6 +430,33 @@ def test_a_second_signal_exits_at_once_and_the_handlers_are_restored():
             os.kill(os.getpid(), signal.SIGTERM)
             time.sleep(1)
         assert not stop.is_set()
+
+
+def test_a_signal_during_the_last_step_is_not_swallowed(tmp_path, monkeypatch, capsys):
+    """SIGTERM in the run's last step: the run finishes and saves it, then the process stops (exit 143), so a caller
+    that trains run after run (experiments.equal_budget under `timeout`) stops too; started again, nothing is left."""
+    config = dataclasses.replace(CONFIG, g_steps=2, d_steps=0, adv_steps=0, checkpoint_every=100, eval_every=100)
+    make_steps, calls = loop.make_steps, []
+
+    def signalling_steps(c):
+        steps = make_steps(c)
+
+        def supervised(*args):
+            calls.append(len(calls))
+            out = steps.supervised(*args)
+            if len(calls) == config.total_steps:  # the last step
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(0.01)  # the handler runs between bytecodes
+            return out
+
+        return dataclasses.replace(steps, supervised=supervised)
+
+    monkeypatch.setattr(loop, "make_steps", signalling_steps)
+    with pytest.raises(SystemExit) as ended:
+        loop.train(config, tmp_path / "run", progress=False)
+    assert ended.value.code == 143 and calls == [0, 1]
+    assert "the run ended with its last step saved; stopping" in capsys.readouterr().err
+    assert int(loop.train(config, tmp_path / "run", progress=False).step) == 2 and calls == [0, 1]  # nothing left
 
 
 def test_init_from_takes_a_model_of_other_settings_but_not_other_parameters(tmp_path, capsys):

@@ -18,6 +18,7 @@ import math
 import os
 import pathlib
 import signal
+import sys
 import threading
 import time
 import warnings
@@ -107,7 +108,9 @@ def _signals_as_exit(save_first: bool):
 
     Yields a _Stop event. save_first (a single-process run): the first signal only sets it; the loop then
     finishes the step it is in, saves a checkpoint of it and exits, so a preempted or interrupted run loses no
-    step. A second signal exits at once (SIGINT as KeyboardInterrupt; the last saved checkpoint is kept). A
+    step; a signal during the last step or the final validation exits once the run is done (never swallowed: a
+    caller that trains run after run stops too). A second signal exits at once (SIGINT as KeyboardInterrupt; the
+    last saved checkpoint is kept). A
     multi-process run exits at once on SIGTERM, and SIGINT keeps Python's KeyboardInterrupt: a checkpoint is a
     collective write that every process would have to reach at the same step. No-op outside the main thread."""
     stop = _Stop()
@@ -131,6 +134,10 @@ def _signals_as_exit(save_first: bool):
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)
+    if stop.is_set():  # it came during the run's last step or final validation: the process stops all the same
+        print(f"[lipjax] {signal.Signals(stop.signum).name}: the run ended with its last step saved; stopping",
+              file=sys.stderr, flush=True)
+        raise SystemExit(128 + stop.signum)
 
 
 def _resume(config: TrainConfig, manager: CheckpointManager, is_main: bool) -> tuple[TrainState, dict]:
