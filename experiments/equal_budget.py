@@ -34,14 +34,13 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
-import math
 import pathlib
 import shutil
 import sys
 
 
 from experiments.configs.study import BRANCHES, METHODS, SCENES, TRUNKS, branch_config, test_split, trunk_config
-from experiments.study_report import write_report
+from experiments.study_report import best_rate, write_report
 from lipjax.train.config import TrainConfig
 from lipjax.console import ArgumentParser, run_main
 from lipjax.data.protocols import get_protocol
@@ -115,7 +114,7 @@ def next_rate(rmse: dict[float, float]) -> float | None:
     for lr in TUNE_LRS:
         if lr not in rmse:
             return lr
-    best = _best(rmse)
+    best = best_rate(rmse)
     top, bottom = TUNE_LRS[-1] * TUNE_FACTOR ** TUNE_EXTENSIONS, TUNE_LRS[0] / TUNE_FACTOR ** TUNE_EXTENSIONS
     if best == max(rmse) and best < top * (1 - 1e-9):
         return float(f"{best * TUNE_FACTOR:.6g}")
@@ -142,12 +141,7 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
         table[trunk] = scores
         _write_json(path, table)
         print(f"[study] {scene} {trunk} lr {lr:g}: val rmse_m={val['rmse_m']:.4f}", flush=True)
-    return _best({float(k): v["val_rmse_m"] for k, v in scores.items()})
-
-
-def _best(rmse: dict[float, float]) -> float:
-    """The rate of the lowest RMSE, a non-finite one (a diverged run) counting as the worst."""
-    return min(rmse, key=lambda r: rmse[r] if math.isfinite(rmse[r]) else math.inf)
+    return best_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})
 
 
 def with_workers(config: TrainConfig, workers: int) -> TrainConfig:

@@ -14,6 +14,7 @@ and against LIP+CNN (the paper's adversarial claim), and the fast prox's LIP+AD 
 from __future__ import annotations
 
 import json
+import math
 import pathlib
 import statistics
 
@@ -132,6 +133,7 @@ def markdown(doc: dict, images: int) -> str:
             else:
                 lines.append(f"| {method} (no training) | | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
                              f"{row['rmse_m'] / linear:.2f}x | |")
+        lines += tuning_table(doc["details"][scene]["tuning_val_rmse_m"])
         tests = doc["details"][scene]["paired_tests"]
         if tests:
             lines += ["", "| paired test | seeds | frames | mean RMSE a / b m | a better on | Wilcoxon p | t-test p |",
@@ -141,6 +143,27 @@ def markdown(doc: dict, images: int) -> str:
                       f"{t['wilcoxon_p']:.2g} | {t['ttest_p']:.2g} |" for t in tests]
         lines.append("")
     return "\n".join(lines)
+
+
+def best_rate(rmse: dict[float, float]) -> float:
+    """The learning rate of the lowest validation RMSE, a non-finite one (a diverged run) counting as the worst."""
+    return min(rmse, key=lambda r: rmse[r] if math.isfinite(rmse[r]) else math.inf)
+
+
+def tuning_table(tuning: dict) -> list[str]:
+    """What tuning tried: each trunk's validation RMSE (m) per learning rate, the chosen one in bold."""
+    if not tuning:
+        return []
+    rates = sorted({float(r) for scores in tuning.values() for r in scores})
+    lines = ["", "Tuning (validation RMSE m after the tuning images, seed 0; the lowest chosen, in bold):", "",
+             "| method | " + " | ".join(f"{r:g}" for r in rates) + " |", "|---|" + "---:|" * len(rates)]
+    for method, scores in tuning.items():
+        by_rate = {float(r): s["val_rmse_m"] for r, s in scores.items()}
+        best = best_rate(by_rate)
+        cells = [("" if r not in by_rate else f"**{by_rate[r]:.3f}**" if r == best else f"{by_rate[r]:.3f}")
+                 for r in rates]
+        lines.append(f"| {method} | " + " | ".join(cells) + " |")
+    return lines
 
 
 def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) -> None:

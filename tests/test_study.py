@@ -66,7 +66,7 @@ def test_tuning_goes_past_the_grid_while_its_edge_is_best_and_at_most_two_steps(
     assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: 0.6}) is None  # the step up lost: 1.25e-3
     assert equal_budget.next_rate({**grid, 2e-4: 0.5}) == 8e-5  # the bottom is best: one step down
     assert equal_budget.next_rate({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) is None  # diverged: the worst
-    assert equal_budget._best({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) == 1.25e-3
+    assert study_report.best_rate({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) == 1.25e-3
 
 
 def test_scores_made_at_another_rate_than_the_tuned_one_are_dropped(tmp_path, capsys):
@@ -169,6 +169,8 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     assert report["indoor"]["lip-ad"]["images"] == 96 and report["indoor"]["lip-ad"]["seeds"] == [0]
     assert set(report["indoor"]) == {"lip-cnn", "lip-ad", "linear", "nearest"}
     assert report["details"]["indoor"]["paired_tests"][0]["b"] == "lip-cnn"  # no end-to-end network ran
+    md = (tmp_path / "report" / "equal_budget.md").read_text()
+    assert "| lip-cnn | " in md.split("Tuning")[1] and md.count("**") == 2  # what was tried, the chosen rate in bold
     assert (tmp_path / "report" / "equal_budget_curve_indoor.png").stat().st_size > 0
     before = {p: p.stat().st_mtime_ns for p in results.glob("*.json")}
     capsys.readouterr()
