@@ -28,10 +28,9 @@ import cv2
 import numpy as np
 
 from benchmarks.common import REALDATA, geometric_mean, indoor_frames, load_kitti
-from lipjax import crosscheck
 from lipjax.data.sampling import LidarSampler, Parallax, sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
-from lipjax.inference import estimate_at, plan_frame
+from lipjax.inference import estimate_frame, plan_frame
 from lipjax.methods import get_completer
 
 WINDOW_PX = 15  # the neighbourhood of a sample, full-size pixels (odd)
@@ -62,35 +61,27 @@ def agreeing(sparse_m: np.ndarray) -> np.ndarray:
     return (sparse_m > 0) & (sparse_m <= (1.0 + FARTHER) * nearest)
 
 
-def finished(completer, rgb: np.ndarray, sparse_m: np.ndarray) -> dict[str, np.ndarray]:
-    """The default path's map, and its estimate finished each other way: {"all", "none", "agreeing"}."""
-    plan = plan_frame(completer, sparse_m)
-    estimate = lambda s, at: estimate_at(completer, rgb, plan, s, at)  # noqa: E731
-    if plan.cross_check:
-        z, _ = crosscheck.cross_checked(estimate, sparse_m, plan.size, scan_lines=plan.scan_lines)
-    else:
-        z = estimate(sparse_m, plan.size)
-    out = {"none": z}
-    for name, keep in (("all", sparse_m > 0), ("agreeing", agreeing(sparse_m))):
-        out[name] = np.where(keep, sparse_m, z).astype(np.float32)
-    return out
-
-
 def ratios(completer, frame, sparse_m: np.ndarray) -> dict[str, float]:
-    """RMSE(variant) / RMSE(all) over the valid ground-truth pixels, measured ones included."""
-    maps = finished(completer, frame.rgb, sparse_m)
+    """RMSE(variant) / RMSE(all) over the valid ground-truth pixels, measured ones included, for the default path's
+    estimate finished each way, and the share of the samples that disagree with their neighbours ("disagreeing")."""
+    z = estimate_frame(completer, frame.rgb, plan_frame(completer, sparse_m), sparse_m)
+    agree = agreeing(sparse_m)
     keep = frame.valid
 
     def rmse(pred):
         return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
 
-    base = rmse(maps["all"])
-    return {v: rmse(maps[v]) / base for v in VARIANTS}
+    base = rmse(np.where(sparse_m > 0, sparse_m, z))
+    return {"none": rmse(z) / base, "agreeing": rmse(np.where(agree, sparse_m, z)) / base,
+            "disagreeing": 1.0 - agree.sum() / max(int((sparse_m > 0).sum()), 1)}
 
 
-def report(name: str, rows: list[dict[str, float]], frac: float) -> dict[str, float]:
+def report(name: str, completer, pairs) -> dict[str, float]:
+    """Prints and returns each variant's geometric-mean ratio over the (frame, sampler) pairs."""
+    rows = [ratios(completer, frame, sampler(frame, 0)) for frame, sampler in pairs]
     means = {v: geometric_mean([r[v] for r in rows]) for v in VARIANTS}
-    print(f"{name:36s} " + " ".join(f"{means[v]:>10.4f}" for v in VARIANTS) + f"   {len(rows):3d}  {frac:6.2%}",
+    share = float(np.mean([r["disagreeing"] for r in rows]))
+    print(f"{name:36s} " + " ".join(f"{means[v]:>10.4f}" for v in VARIANTS) + f"   {len(rows):3d}  {share:6.2%}",
           flush=True)
     return means
 
@@ -103,14 +94,8 @@ def main(argv=None) -> None:
     completer = get_completer(None)
     print(f"{'setting':36s} {'none':>10s} {'agreeing':>10s}   frames  samples disagreeing   "
           f"(geometric mean of RMSE / RMSE with every sample set back)")
-    decided = {}
-    for name, kind, size, sampler in SETTINGS:
-        rows, flagged = [], []
-        for s in SyntheticDataset(kind, "test", size=args.frames, height=size[0], width=size[1]):
-            sparse = sampler(s, 0)
-            rows.append(ratios(completer, s, sparse))
-            flagged.append(1.0 - agreeing(sparse).sum() / max(int((sparse > 0).sum()), 1))
-        decided[name] = report(name, rows, float(np.mean(flagged)))
+    decided = {name: report(name, completer, [(f, sampler) for f in SyntheticDataset(
+        kind, "test", size=args.frames, height=size[0], width=size[1])]) for name, kind, size, sampler in SETTINGS}
     passing = [v for v in VARIANTS if decided[DECIDING][v] <= 1 - GAIN
                and all(decided[n][v] <= 1 + LOSS for n in decided if n != DECIDING)]
     choice = min(passing, key=lambda v: decided[DECIDING][v]) if passing else "all"
@@ -118,18 +103,13 @@ def main(argv=None) -> None:
     if not os.path.isdir(args.realdata):
         print(f"no real frames in {args.realdata}: synthetic only")
         return
-    real = [("real KITTI, HDL-64 on the ground truth", s, LidarSampler.hdl64())
-            for s in load_kitti(os.path.join(args.realdata, "kitti"))]
-    real += [("real indoor, 1000 points, RGB-D offset", s,
+    real = [("real KITTI, HDL-64 on the ground truth", f, LidarSampler.hdl64())
+            for f in load_kitti(os.path.join(args.realdata, "kitti"))]
+    real += [("real indoor, 1000 points, RGB-D offset", f,
               Parallax.at(sampler_from_spec("uniform:1000"), RGBD_DEPTH_SENSOR_M))
-             for s in indoor_frames(args.realdata) if s.valid.mean() > 0.85]
+             for f in indoor_frames(args.realdata) if f.valid.mean() > 0.85]
     for group in dict.fromkeys(g for g, _, _ in real):
-        rows, flagged = [], []
-        for _, s, sampler in (r for r in real if r[0] == group):
-            sparse = sampler(s, 0)
-            rows.append(ratios(completer, s, sparse))
-            flagged.append(1.0 - agreeing(sparse).sum() / max(int((sparse > 0).sum()), 1))
-        report(group, rows, float(np.mean(flagged)))
+        report(group, completer, [(f, sampler) for g, f, sampler in real if g == group])
 
 
 if __name__ == "__main__":

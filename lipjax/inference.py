@@ -358,20 +358,25 @@ def complete_frame(completer, rgb: np.ndarray, sparse_m: np.ndarray, max_side: i
     # 2. the plan: the samples' pattern asked once, and every decision that follows from it
     if plan is None:
         plan = plan_frame(completer, sparse_m, max_side, flip=flip, cross_check=cross_check)
-    # 3. the estimate from a set of samples at a size (`estimate_at`): the RGB and the samples to the working size,
-    #    the initial estimate, the network (flip-averaged), the resize back, the residuals spread
-    estimate = functools.partial(estimate_at, completer, rgb, plan)
-    # 4. with the cross-check: held-out folds, the model against the linear fill, blended where it is the worse
-    if plan.cross_check:
-        dense, _ = crosscheck.cross_checked(estimate, sparse_m, plan.size, scan_lines=plan.scan_lines)
-    else:
-        dense = estimate(sparse_m, plan.size)
+    # 3-4. the estimate, cross-checked where the plan says so (`estimate_frame`)
+    dense = estimate_frame(completer, rgb, plan, sparse_m)
     # 5. the measured pixels set back: the final x-update with rho -> 0 where m = 1 (also under a sensor's parallax:
     #    docs/decisions/0029-set-back-under-parallax.md)
     if plan.set_back:
         measured = sparse_m > 0
         dense[measured] = sparse_m[measured]
     return dense  # lipjax.complete then: --fill-all, the expected error, --blank-unsupported (lipjax.methods)
+
+
+def estimate_frame(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarray) -> np.ndarray:
+    """The default path's (H, W) float32 metres before the measured pixels are set back (`complete_frame`)."""
+    # 3. the estimate from a set of samples at a size (`estimate_at`): the RGB and the samples to the working size,
+    #    the initial estimate, the network (flip-averaged), the resize back, the residuals spread
+    estimate = functools.partial(estimate_at, completer, rgb, plan)
+    # 4. with the cross-check: held-out folds, the model against the linear fill, blended where it is the worse
+    if plan.cross_check:
+        return crosscheck.cross_checked(estimate, sparse_m, plan.size, scan_lines=plan.scan_lines)[0]
+    return estimate(sparse_m, plan.size)
 
 
 def estimate_at(completer, rgb: np.ndarray, plan: FramePlan, sparse_m: np.ndarray,
