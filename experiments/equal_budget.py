@@ -182,7 +182,7 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
             score(study, scene, trunk, seed, images, model, lr)
     for method in wanted_branches:
         for images in budgets:
-            run_branch(study, scene, method, config, workdir, seed, images, progress)
+            run_branch(study, scene, method, lr, workdir, seed, images, progress)
 
 
 def drop_stale_scores(study: Study, scene: str, methods: list[str], seed: int, lr: float) -> None:
@@ -220,17 +220,17 @@ def _needed(study: Study, scene: str, trunk: str, seed: int, images: int, budget
                for m in branches)
 
 
-def run_branch(study: Study, scene: str, method: str, trunk: TrainConfig, trunk_dir: pathlib.Path, seed: int,
-               images: int, progress: bool) -> None:
+def run_branch(study: Study, scene: str, method: str, lr: float, trunk_dir: pathlib.Path, seed: int, images: int,
+               progress: bool) -> None:
     """LIP+AD `method` at `images`: from its trunk's model (run in `trunk_dir`) at images - adv_images
-    (experiments/configs/study.py), at the trunk's learning rate."""
+    (experiments/configs/study.py), at the trunk's learning rate `lr`."""
     from lipjax.train.run import run
 
     if result_path(study, scene, method, seed, images).exists():
         return
     start = trunk_dir / "models" / str(images - study.adv_images)
-    config = branch_config(method, trunk, str(start), study.adv_images)
-    lr = trunk.learning_rate
+    config = with_workers(branch_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
+                                        adv_images=study.adv_images, tiny=study.tiny), study.workers)
     workdir = study.scene_dir(scene) / method / f"lr{lr:g}" / f"seed{seed}" / str(images)
     model = workdir / "model"
     if not model.with_suffix(".msgpack").exists():

@@ -2,6 +2,7 @@
 end-to-end networks' depth unit, the paired tests, and one tiny study end to end (resumed, then reported)."""
 import dataclasses
 import json
+import pathlib
 
 import jax
 import jax.numpy as jnp
@@ -11,9 +12,11 @@ import pytest
 import lipjax
 from scipy import stats
 
-from experiments import equal_budget, study_report
+from experiments import equal_budget, ship_study, study_report
 from experiments.configs.study import BRANCH_SEED_OFFSET, branch_config, trunk_config
+from lipjax import model_io
 from lipjax.networks import baseline_preset
+from lipjax.train.run import logged_validation
 from lipjax.train.state import g_learning_rate
 
 
@@ -83,14 +86,15 @@ def test_scores_made_at_another_rate_than_the_tuned_one_are_dropped(tmp_path, ca
 
 def test_a_branch_reads_its_budget_of_images_on_a_stream_of_its_own():
     trunk = trunk_config("lip-cnn", "indoor", learning_rate=5e-4, seed=2, steps=3750)
-    branch = branch_config("lip-ad", trunk, "start", 2000)
+    branch = branch_config("lip-ad", "indoor", learning_rate=5e-4, seed=2, init_from="start", adv_images=2000)
     assert (branch.d_steps, branch.adv_steps, branch.g_steps) == (50, 200, 0)  # the paper's LIP+AD split
     assert branch.total_steps * branch.batch_size == 2000
     assert branch.seed == 2 + BRANCH_SEED_OFFSET and branch.learning_rate == trunk.learning_rate
     assert branch.name == "study-lip-ad-indoor" and branch.init_from == "start"
-    fast = branch_config("lip-ad-fast", trunk_config("lip-fast", "indoor", learning_rate=5e-4, seed=0, steps=10),
-                         "start", 2000)
+    assert (branch.model, branch.data, branch.schedule) == (trunk.model, trunk.data, trunk.schedule)  # G as trained
+    fast = branch_config("lip-ad-fast", "indoor", learning_rate=5e-4, seed=0, init_from="start", adv_images=2000)
     assert fast.name == "study-lip-ad-fast-indoor" and fast.discriminator.inputs == "log_gradients"
+    assert fast.model == trunk_config("lip-fast", "indoor", learning_rate=5e-4, seed=0, steps=10).model
 
 
 def test_constant_schedule_holds_the_rate_after_warm_up_whatever_the_run_length():
@@ -172,8 +176,32 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     md = (tmp_path / "report" / "equal_budget.md").read_text()
     assert "| lip-cnn | " in md.split("Tuning")[1] and md.count("**") == 2  # what was tried, the chosen rate in bold
     assert (tmp_path / "report" / "equal_budget_curve_indoor.png").stat().st_size > 0
+    _ships_as_the_papers_methods(tmp_path, results)
     before = {p: p.stat().st_mtime_ns for p in results.glob("*.json")}
     capsys.readouterr()
     equal_budget.main(args)  # everything is done: nothing is trained or scored again
     assert {p: p.stat().st_mtime_ns for p in results.glob("*.json")} == before
     assert "test rmse_m" not in capsys.readouterr().out
+
+
+def _ships_as_the_papers_methods(tmp_path, results):
+    """experiments/ship_study.py on the tiny study: a scene ships all of its methods or none; a shipped model is the
+    study's, weight for weight, named for its config, with the validation its training logged."""
+    with pytest.raises(ValueError, match="no seed-0 score at 96 images for ma2018, unet, cspn, lip-fast, lip-ad-fast"):
+        ship_study.main(["--images", "96", "--scores", str(tmp_path / "scores"), "--scene", "indoor",
+                         "--out", str(tmp_path / "weights"), "--tiny"])
+    for method in ("lip-cnn", "lip-ad"):
+        score = json.loads((results / f"{method}-seed0-96.json").read_text())
+        meta = ship_study.ship(method, "indoor", score, tmp_path / "weights", tiny=True)
+        config, params, shipped = model_io.load(tmp_path / "weights" / f"{method}-indoor")
+        study_config, study_params, _ = model_io.load(score["model"])
+        assert config == study_config and jax.tree.all(jax.tree.map(np.array_equal, params, study_params))
+        assert shipped == meta and (shipped["train_config"], shipped["seed"], shipped["images_seen"]) == (
+            f"{method}-indoor", 0, 96)
+        assert shipped["study"] == {"budget_images": 96, "learning_rate": score["learning_rate"],
+                                    "test_rmse_m": score["rmse_m"], "test_mae_m": score["mae_m"]}
+    # the branch validated at its last step while training: the same frames, the same model, the same RMSE
+    logged = logged_validation(pathlib.Path(score["model"]).parent / "metrics.jsonl", meta["steps"])
+    assert meta["val_metrics"]["rmse_m"] == pytest.approx(logged["rmse_m"], rel=1e-6)
+    line = ship_study.expected_line("lip-ad", "indoor", meta)
+    assert "images_seen=96, budget_from_config=False" in line and "lip-cnn seed 0 to 56 images, then 40 with D" in line

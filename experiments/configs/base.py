@@ -12,6 +12,7 @@ import dataclasses
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
+from lipjax.networks import baseline_preset
 from lipjax.priors.fast import PRESETS as FAST_PRESETS
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
@@ -89,6 +90,16 @@ def lip_model(max_depth_m: float, initial_estimate: str, output: str = "x",
     """The paper-style LIP: the "small" network prox (lipjax.priors.network), 3 iterations."""
     prior = dataclasses.replace(network_preset("small", max_depth_m=max_depth_m), depth_domain=depth_domain)
     return LIPConfig(prior=prior, num_iterations=3, initial_estimate=initial_estimate, output=output)
+
+
+# The end-to-end networks (lipjax.networks): Ma et al. [2], U-Net [6], CSPN [7], at about LIP small's parameter count.
+END_TO_END_TYPES = {"ma2018": "sparse_to_dense", "unet": "unet", "cspn": "cspn"}
+END_TO_END_PRESET = "small"
+
+
+def end_to_end_model(method: str, max_depth_m: float, preset: str = END_TO_END_PRESET):
+    """The end-to-end network `method` (a key of END_TO_END_TYPES) at lipjax.networks preset `preset`."""
+    return baseline_preset(END_TO_END_TYPES[method], preset, max_depth_m=max_depth_m)
 
 
 def fast_model(max_depth_m: float, initial_estimate: str) -> LIPConfig:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import INDOOR, INDOOR_MAX_DEPTH_M, OUTDOOR, OUTDOOR_MAX_DEPTH_M, Expected
-from lipjax.networks import baseline_preset
+from experiments.configs.base import (END_TO_END_TYPES, INDOOR, INDOOR_MAX_DEPTH_M, OUTDOOR, OUTDOOR_MAX_DEPTH_M,
+                                      Expected, end_to_end_model)
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 
@@ -26,21 +26,17 @@ LIP_AD_OUTDOOR = dataclasses.replace(
     learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3, discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M),
 )
 
-# End-to-end baselines (lipjax.networks; Ma et al. [2], U-Net [6], CSPN [7]) at about LIP small's parameter count.
-BASELINE_PRESET = "small"
-BASELINE_TYPES = {"ma2018": "sparse_to_dense", "unet": "unet", "cspn": "cspn"}
-
-
-def baseline(base: TrainConfig, name: str, model_type: str, **run) -> TrainConfig:
+def baseline(base: TrainConfig, name: str, method: str, **run) -> TrainConfig:
     """The LIP+CNN run of scene `base` (data, batch size, depth loss, steps, schedule; `run`: fields of a real-data
-    run) with an end-to-end network. Without the inverse-depth term: from random initialisation it diverged."""
-    model = baseline_preset(model_type, BASELINE_PRESET, max_depth_m=base.model.max_depth_m)
+    run) with the end-to-end network `method` (base.END_TO_END_TYPES). Without the inverse-depth term: from random
+    initialisation it diverged."""
+    model = end_to_end_model(method, base.model.max_depth_m)
     return dataclasses.replace(base, name=name, model=model, inverse_depth_weight=0.0, **run)
 
 
 BASELINE_CONFIGS: dict[str, TrainConfig] = {
-    f"{key}_{scene}": baseline(base, f"{key}-{scene}", model_type)
-    for key, model_type in BASELINE_TYPES.items() for scene, base in (("indoor", INDOOR), ("outdoor", OUTDOOR))
+    f"{key}_{scene}": baseline(base, f"{key}-{scene}", key)
+    for key in END_TO_END_TYPES for scene, base in (("indoor", INDOOR), ("outdoor", OUTDOOR))
 }
 
 CONFIGS: dict[str, TrainConfig] = {

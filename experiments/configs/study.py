@@ -13,19 +13,17 @@ from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import INDOOR, OUTDOOR, fast_model
-from experiments.configs.paper import BASELINE_PRESET, baseline
+from experiments.configs.base import END_TO_END_TYPES, INDOOR, OUTDOOR, end_to_end_model, fast_model
 from lipjax.data.synthetic.dataset import SyntheticDataset
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
-from lipjax.networks import baseline_preset
 from lipjax.priors.network import network_preset
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.discriminator import Discriminator
 
 SCENES = ("indoor", "outdoor")
 BASES = {"indoor": INDOOR, "outdoor": OUTDOOR}
-END_TO_END = ("ma2018", "unet", "cspn")  # the end-to-end networks (lipjax.networks)
+END_TO_END = tuple(END_TO_END_TYPES)  # the end-to-end networks (lipjax.networks)
 TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
 # branch -> (its trunk, what D sees): the paper's D on depth for the paper's prox; on log-depth gradients for the
 # fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
@@ -47,54 +45,60 @@ END_TO_END_DEPTH_SCALE = "samples"
 TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
 
 
-def _tiny(config: TrainConfig) -> TrainConfig:
-    h, w = TINY_SIZE
-    return dataclasses.replace(config, data=dataclasses.replace(config.data, height=h, width=w, crop=TINY_CROP,
-                                                                val_images=4))
+def trunk_model(method: str, scene: str, tiny: bool = False):
+    """The model of trunk `method` on `scene` (tiny: the tests' tiny networks)."""
+    base, max_depth = BASES[scene], SCENE_MAX_DEPTH_M[scene]
+    if method in END_TO_END:
+        model = end_to_end_model(method, max_depth, **({"preset": "tiny"} if tiny else {}))
+        return dataclasses.replace(model, depth_scale=END_TO_END_DEPTH_SCALE)
+    if method == "lip-cnn":
+        return base.model if not tiny else dataclasses.replace(base.model, prior=dataclasses.replace(
+            network_preset("tiny", max_depth_m=max_depth), depth_domain=base.model.prior.depth_domain))
+    if tiny:
+        return LIPConfig(prior=network_preset("tiny", max_depth_m=max_depth), num_iterations=2,
+                         initial_estimate=base.model.initial_estimate)
+    return fast_model(max_depth, base.model.initial_estimate)
+
+
+def _run(method: str, scene: str, tiny: bool, **fields) -> TrainConfig:
+    """One `dataclasses.replace` of the scene base: trunk `method`'s model, the study's run, and `fields`."""
+    if method not in TRUNKS:
+        raise ValueError(f"unknown trunk {method!r}; choose one of {TRUNKS}")
+    base = BASES[scene]
+    data = base.data if not tiny else dataclasses.replace(base.data, height=TINY_SIZE[0], width=TINY_SIZE[1],
+                                                          crop=TINY_CROP, val_images=4)
+    run = dict(model=trunk_model(method, scene, tiny), data=data, schedule="constant", init_from=None,
+               keep_checkpoints=2, log_every=50)
+    if method in END_TO_END:
+        run["inverse_depth_weight"] = 0.0  # from random initialisation it diverged (experiments/configs/paper.py)
+    return dataclasses.replace(base, **{**run, **fields})
 
 
 def trunk_config(method: str, scene: str, *, learning_rate: float, seed: int, steps: int,
-                 tiny: bool = False) -> TrainConfig:
-    """The run of trunk `method` on `scene` for `steps` steps (batch 8): the scene base with that model, the
-    constant schedule, checkpoints every 250 steps (2,000 images), validation every 1,250 (10,000 images)."""
-    if method not in TRUNKS:
-        raise ValueError(f"unknown trunk {method!r}; choose one of {TRUNKS}")
-    base, max_depth = BASES[scene], SCENE_MAX_DEPTH_M[scene]
-    if method in END_TO_END:
-        model_type = {"ma2018": "sparse_to_dense", "unet": "unet", "cspn": "cspn"}[method]
-        config = baseline(base, method, model_type)
-        model = baseline_preset(model_type, "tiny" if tiny else BASELINE_PRESET, max_depth_m=max_depth)
-        config = dataclasses.replace(config, model=dataclasses.replace(model, depth_scale=END_TO_END_DEPTH_SCALE))
-    elif method == "lip-cnn":
-        config = base if not tiny else dataclasses.replace(
-            base, model=dataclasses.replace(base.model, prior=dataclasses.replace(
-                network_preset("tiny", max_depth_m=max_depth), depth_domain=base.model.prior.depth_domain)))
-    else:
-        model = fast_model(max_depth, base.model.initial_estimate)
-        config = dataclasses.replace(base, model=model if not tiny else LIPConfig(
-            prior=network_preset("tiny", max_depth_m=max_depth), num_iterations=2,
-            initial_estimate=base.model.initial_estimate))
-    config = dataclasses.replace(
-        config, name=f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate, schedule="constant",
-        g_steps=steps, d_steps=0, adv_steps=0, warmup_steps=WARMUP_STEPS, init_from=None, checkpoint_every=250,
-        eval_every=1250, keep_checkpoints=2, log_every=50)
-    return _tiny(config) if tiny else config
+                 tiny: bool = False, name: str | None = None) -> TrainConfig:
+    """The run of trunk `method` on `scene` for `steps` steps (batch 8), named `name` (default study-<method>-<scene>):
+    the scene base with that model, the constant schedule, checkpoints every 250 steps (2,000 images), validation
+    every 1,250 (10,000 images)."""
+    return _run(method, scene, tiny, name=name or f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate,
+                g_steps=steps, d_steps=0, adv_steps=0, warmup_steps=WARMUP_STEPS, checkpoint_every=250,
+                eval_every=1250)
 
 
-def branch_config(method: str, trunk: TrainConfig, init_from: str, adv_images: int) -> TrainConfig:
-    """LIP+AD `method` from the trunk's model at `init_from`: BRANCH_D_STEPS steps of D, then the joint steps, in all
-    adv_images images (batch 8) at the trunk's learning rate."""
-    _, inputs = BRANCHES[method]
-    steps = adv_images // trunk.batch_size
+def branch_config(method: str, scene: str, *, learning_rate: float, seed: int, init_from: str, adv_images: int,
+                  tiny: bool = False, name: str | None = None) -> TrainConfig:
+    """LIP+AD `method` of seed `seed` on `scene`, named `name` (default study-<method>-<scene>), from its trunk's model
+    at `init_from`: BRANCH_D_STEPS steps of D, then the joint steps, in all adv_images images (batch 8) at the
+    trunk's learning rate, on a stream of its own (seed + BRANCH_SEED_OFFSET)."""
+    trunk, inputs = BRANCHES[method]
+    steps = adv_images // BASES[scene].batch_size
     d_steps = min(BRANCH_D_STEPS, steps // 5)  # a fifth at most: the tiny check's few steps
     if d_steps < 1:
         raise ValueError(f"adv_images {adv_images} gives {steps} steps; LIP+AD needs at least 5 (a fifth of them D "
                          "pretraining, the rest joint steps)")
-    name = trunk.name.replace(BRANCHES[method][0], method, 1)
-    return dataclasses.replace(
-        trunk, name=name, init_from=init_from, seed=trunk.seed + BRANCH_SEED_OFFSET, g_steps=0, d_steps=d_steps,
-        adv_steps=steps - d_steps, warmup_steps=20, adv_weight=1e-3, eval_every=steps, checkpoint_every=50,
-        discriminator=Discriminator(max_depth_m=trunk.model.max_depth_m, inputs=inputs))
+    return _run(trunk, scene, tiny, name=name or f"study-{method}-{scene}", init_from=init_from,
+                seed=seed + BRANCH_SEED_OFFSET, learning_rate=learning_rate, g_steps=0, d_steps=d_steps,
+                adv_steps=steps - d_steps, warmup_steps=20, adv_weight=1e-3, eval_every=steps, checkpoint_every=50,
+                discriminator=Discriminator(max_depth_m=SCENE_MAX_DEPTH_M[scene], inputs=inputs))
 
 
 def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:

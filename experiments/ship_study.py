@@ -1,0 +1,107 @@
+"""Ships the equal-budget study's seed-0 models (experiments/equal_budget.py) as the paper's learned methods
+(lipjax/weights/<method>-<scene>), so that the main job's tables compare equal training budgets (issue 52).
+
+    python -m experiments.ship_study --images 30000 --dry-run     # what it would write, and from which runs
+    python -m experiments.ship_study --images 30000               # every method of every scene that reached it
+
+A method is shipped from its seed-0 score at the budget (experiments/study_scores/<scene>/<method>-seed0-<N>.json,
+which names the model it scored). Its weights and training record are kept; its metadata gains train_config
+<method>-<scene> (the name experiments/configs gives its config), seed, the validation metrics of that config's
+validation frames (measured here) and "study": the budget, the learning rate and the test RMSE of the study's
+score. A scene ships all of its methods or none: a table of equal budgets or nothing. Printed at the end: the
+experiments/configs EXPECTED lines the shipped files now state.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import sys
+
+from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, branch_config, trunk_config
+from experiments.equal_budget import SCORES
+from lipjax.console import ArgumentParser, positive_int, run_main
+from lipjax.shipped import WEIGHTS_DIR
+
+PROG = f"python -m {__spec__.name}"
+SEED = 0  # the shipped run of each method
+
+
+def shipped_name(method: str, scene: str) -> str:
+    """The shipped model (and config) name of study method `method` on `scene`, e.g. ma2018-indoor."""
+    return f"{method}-{scene}"
+
+
+def scores_of(scores: pathlib.Path, scene: str, images: int) -> dict[str, dict]:
+    """method -> its seed-0 score at `images` on `scene`; a one-line ValueError names what is missing."""
+    paths = {m: scores / scene / f"{m}-seed{SEED}-{images}.json" for m in METHODS}
+    missing = [m for m, p in paths.items() if not p.exists()]
+    if missing:
+        raise ValueError(f"{scene}: no seed-{SEED} score at {images:,} images for {', '.join(missing)}; run "
+                         "`python -m experiments.equal_budget` on to that budget first (--plan lists what is left)")
+    return {m: json.loads(p.read_text()) for m, p in paths.items()}
+
+
+def validation_config(method: str, scene: str, learning_rate: float, tiny: bool):
+    """The study config of `method` (validation frames and sampler are the scene base's for every method)."""
+    if method in BRANCHES:
+        return branch_config(method, scene, learning_rate=learning_rate, seed=SEED, init_from="-", adv_images=2000,
+                             tiny=tiny)
+    return trunk_config(method, scene, learning_rate=learning_rate, seed=SEED, steps=1, tiny=tiny)
+
+
+def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = False) -> dict:
+    """Writes out/<method>-<scene>.{json,msgpack} from the model of `score`; returns its metadata."""
+    from lipjax import model_io
+    from lipjax.train.loop import evaluate_params, validation_batches
+
+    model_config, params, meta = model_io.load(score["model"])
+    if meta.get("images_seen") != score["images"]:
+        raise ValueError(f"{score['model']} has read {meta.get('images_seen')} images, its score says "
+                         f"{score['images']}")
+    config = validation_config(method, scene, score["learning_rate"], tiny)
+    val = evaluate_params(model_config, params, validation_batches(config), model_config.max_depth_m)
+    meta = {**meta, "train_config": shipped_name(method, scene), "seed": SEED, "val_metrics": val,
+            "val_sampler": config.data.val_sampler, "val_images": config.data.val_images,
+            "study": {"budget_images": score["images"], "learning_rate": score["learning_rate"],
+                      "test_rmse_m": score["rmse_m"], "test_mae_m": score["mae_m"]}}
+    model_io.save(out / shipped_name(method, scene), model_config, params, meta)
+    return meta
+
+
+def expected_line(method: str, scene: str, meta: dict) -> str:
+    """The experiments/configs EXPECTED entry of a shipped model's metadata."""
+    key, images = shipped_name(method, scene).replace("-", "_"), meta["images_seen"]
+    note = ""
+    if method in BRANCHES:  # its config starts from the shipped trunk, which read the whole budget
+        adversarial = meta["steps"] * BASES[scene].batch_size
+        note = (f', budget_from_config=False, note="the study\'s LIP+AD: {BRANCHES[method][0]} seed {SEED} to '
+                f'{images - adversarial:,} images, then {adversarial:,} with D"')
+    return f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}{note}),'
+
+
+def main(argv=None) -> list[str]:
+    p = ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--images", type=positive_int, required=True, help="the budget to ship (training images)")
+    p.add_argument("--scene", choices=SCENES, action="append", help="a scene to ship (default: both)")
+    p.add_argument("--scores", default=SCORES, help="the study's scores (default: %(default)s)")
+    p.add_argument("--out", default=str(WEIGHTS_DIR), help="where the models go (default: the shipped models)")
+    p.add_argument("--tiny", action="store_true", help="a tiny study's models (checks, not results)")
+    p.add_argument("--dry-run", action="store_true", help="say what would be shipped; write nothing")
+    args = p.parse_args(argv)
+    scores, out = pathlib.Path(args.scores), pathlib.Path(args.out)
+    found = {scene: scores_of(scores, scene, args.images) for scene in args.scene or SCENES}
+    lines = []
+    for scene, by_method in found.items():
+        for method, score in by_method.items():
+            print(f"[ship] {shipped_name(method, scene)} <- {score['model']} (test rmse_m={score['rmse_m']:.4f})",
+                  flush=True)
+            if not args.dry_run:
+                lines.append(expected_line(method, scene, ship(method, scene, score, out, args.tiny)))
+    if lines:
+        print("EXPECTED entries (experiments/configs):\n" + "\n".join(lines))
+    return lines
+
+
+if __name__ == "__main__":
+    sys.exit(run_main(PROG, main))
