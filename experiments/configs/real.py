@@ -13,7 +13,8 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from experiments.configs.base import END_TO_END_TYPES, INDOOR, INDOOR_MAX_DEPTH_M, OUTDOOR, OUTDOOR_MAX_DEPTH_M
+from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_TYPES, INDOOR, INDOOR_MAX_DEPTH_M, OUTDOOR,
+                                      OUTDOOR_MAX_DEPTH_M)
 from experiments.configs.paper import baseline
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.discriminator import Discriminator
@@ -68,7 +69,7 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_cnn_folder": LIP_CNN_FOLDER,
 }
 REAL_DATA_BASELINES: dict[str, TrainConfig] = {
-    f"{key}_{data}": baseline(base, f"{key}-{data}", key, **run)
+    f"{key}_{data}": baseline(base, f"{key}-{data}", key, depth_scale=END_TO_END_DEPTH_SCALE, **run)
     for key in END_TO_END_TYPES
     for data, base, run in (("nyu", INDOOR, NYU_RUN), ("kitti", OUTDOOR, KITTI_RUN),
                             ("tartanair", OUTDOOR, TARTANAIR_RUN))

@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import END_TO_END_TYPES, INDOOR, OUTDOOR, end_to_end_model, fast_model
+from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_TYPES, INDOOR, OUTDOOR, end_to_end_model,
+                                      fast_model)
 from lipjax.data.synthetic.dataset import SyntheticDataset
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
@@ -36,11 +37,6 @@ BRANCH_D_STEPS = 50
 # trunk's first batches again: a batch is a function of the seed and the step).
 BRANCH_SEED_OFFSET = 1000
 WARMUP_STEPS = 100
-# The end-to-end networks see depth in units of each frame's own sample scale (lipjax.networks.common.DEPTH_SCALES):
-# in units of the 10 m depth range, Ma et al. at 3,000 images scored a validation RMSE of 1.22 m and ignored the
-# samples' level (its per-frame medians barely followed the truth's; GroupNorm erases a frame's absolute level); in
-# units of the samples, 0.53 m at the same budget and learning rate (docs/decisions/0027-end-to-end-depth-unit.md).
-END_TO_END_DEPTH_SCALE = "samples"
 # The tiny variant (tests; a check of the GPU script): tiny networks on 48x64 renders, 32x48 crops.
 TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
 
@@ -49,8 +45,8 @@ def trunk_model(method: str, scene: str, tiny: bool = False):
     """The model of trunk `method` on `scene` (tiny: the tests' tiny networks)."""
     base, max_depth = BASES[scene], SCENE_MAX_DEPTH_M[scene]
     if method in END_TO_END:
-        model = end_to_end_model(method, max_depth, **({"preset": "tiny"} if tiny else {}))
-        return dataclasses.replace(model, depth_scale=END_TO_END_DEPTH_SCALE)
+        return end_to_end_model(method, max_depth, depth_scale=END_TO_END_DEPTH_SCALE,
+                                **({"preset": "tiny"} if tiny else {}))
     if method == "lip-cnn":
         return base.model if not tiny else dataclasses.replace(base.model, prior=dataclasses.replace(
             network_preset("tiny", max_depth_m=max_depth), depth_domain=base.model.prior.depth_domain))
