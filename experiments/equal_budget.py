@@ -7,13 +7,14 @@ the tables' synthetic test splits (issue 52).
     python -m experiments.equal_budget --plan          # what is done and what is left, without running anything
     python -m experiments.equal_budget --report        # docs/results/equal_budget.json, tables, figures, tests
     python -m experiments.equal_budget --tiny --root /tmp/study --images 96 --curve 48,96 --tune-images 32 \\
-        --adv-images 40 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames
+        --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames
 
 Methods (experiments/configs/study.py): Ma et al. (ma2018), U-Net, CSPN, LIP+CNN with the paper's prox (lip-cnn),
-LIP with the fast prox (lip-fast), and LIP+AD of each (lip-ad, lip-ad-fast: the last adv_images of the budget
+LIP with the fast prox (lip-fast), and LIP+AD of each (lip-ad, lip-ad-fast: their trunk's cool-down made
 adversarial). LIP+Wavelet needs no training and is not part of the study. Every run reads the scene's training data
-with the study's seed, batch 8, a constant learning rate after 100 warm-up steps; "images" counts G's training
-images (batch x steps, a branch's D steps included), equal for every method.
+with the study's seed, batch 8; a trunk at a constant learning rate after 100 warm-up steps, and the model at budget
+N is the trunk's at N - C cooled down over C = --cooldown x N more images (the rate decaying linearly to 0).
+"images" counts G's training images (batch x steps, LIP+AD's D steps included), equal for every method.
 
 Stages, each skipped when its output exists, so the study continues across sessions and survives any stop (every
 run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
@@ -23,8 +24,9 @@ experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k> to be continued f
   1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS and,
      while the best is the grid's edge, rates beyond it (`next_rate`; seed 0, the validation split: never the test
      split); the same small budget for every trunk;
-  2. per scene, per seed: each trunk to each budget of its curve (--curve points <= --images for every seed, all of
-     --curve for seed 0), its model exported and scored on the test split at each; each branch at each budget;
+  2. per scene, per seed: each trunk on to N - C for each budget N of its curve (--curve points <= --images for
+     every seed, all of --curve for seed 0), its model exported there; then at each budget the cool-down of the
+     trunk and of each LIP+AD, each scored on the test split;
   3. the report (also --report): docs/results/equal_budget.json, docs/results/equal_budget.md, the data-efficiency
      curve and Fig. 4a (RMSE against the ADMM iteration count K over the seeds) as PNGs, and paired tests.
 Order: the tuning and every seed at --images on rooms, then streets, then seed 0 beyond --images (the curve).
@@ -39,7 +41,8 @@ import shutil
 import sys
 
 
-from experiments.configs.study import BRANCHES, METHODS, SCENES, TRUNKS, branch_config, test_split, trunk_config
+from experiments.configs.study import (BRANCHES, COOLDOWN_FRACTION, METHODS, SCENES, TRUNKS, cooldown_config,
+                                      cooldown_images, test_split, trunk_config)
 from experiments.study_report import best_rate, write_report
 from lipjax.train.config import TrainConfig
 from lipjax.console import ArgumentParser, run_main
@@ -66,7 +69,7 @@ WARM_STARTS = pathlib.Path("experiments/warm_starts/study")
 @dataclasses.dataclass(frozen=True)
 class Study:
     """What to run. images: the budget B of every run of the tables; curve: the budgets scored on the way (seed 0
-    goes on to the largest); adv_images: the adversarial part of a LIP+AD budget; limit: test frames (None: the
+    goes on to the largest); cooldown: the cool-down's share of each budget; limit: test frames (None: the
     tables' own counts); tiny: tiny networks and frames (checks, not results)."""
 
     root: pathlib.Path
@@ -76,7 +79,7 @@ class Study:
     images: int = 30_000
     curve: dict = dataclasses.field(default_factory=lambda: dict(DEFAULT_CURVE))
     tune_images: int = 3_000
-    adv_images: int = 2_000
+    cooldown: float = COOLDOWN_FRACTION
     limit: int | None = None
     tiny: bool = False
     methods: tuple[str, ...] = METHODS
@@ -84,17 +87,24 @@ class Study:
     warm_starts: pathlib.Path | None = WARM_STARTS  # committed workdirs to go on from (None: never; the tiny check)
 
     def __post_init__(self):
-        for n in (self.images, self.tune_images, self.adv_images, *[c for cs in self.curve.values() for c in cs]):
+        for n in (self.images, self.tune_images, *[c for cs in self.curve.values() for c in cs]):
             if n % BATCH or n <= 0:
                 raise ValueError(f"image counts must be positive multiples of the batch size {BATCH}, got {n}")
-        if self.adv_images >= min(self.budgets_for(s, 0)[0] for s in self.scenes):
-            raise ValueError(f"--adv-images {self.adv_images} must be below the smallest budget")
+        smallest = min(self.budgets_for(s, 0)[0] for s in self.scenes)
+        if not 0 < self.cooldown < 1 or not 2 * BATCH <= self.cooldown_images(smallest) < smallest:
+            raise ValueError(f"--cooldown {self.cooldown} leaves {self.cooldown_images(smallest)} of the smallest "
+                             f"budget's {smallest} images to the cool-down; it needs 2 steps ({2 * BATCH} images) "
+                             "and must leave some to the trunk")
 
     def budgets_for(self, scene: str, seed: int) -> list[int]:
         """The budgets a run of `seed` is scored at: the curve's up to `images`, and `images`; seed 0 all of the
         curve."""
         curve = self.curve.get(scene, ())
         return sorted({self.images, *(c for c in curve if c <= self.images or seed == 0)})
+
+    def cooldown_images(self, budget: int) -> int:
+        """The images of the cool-down that ends at `budget` (the trunk's model at budget minus them starts it)."""
+        return cooldown_images(budget, self.cooldown, BATCH)
 
     def scene_dir(self, scene: str) -> pathlib.Path:
         """The runs, checkpoints and models of a scene (not committed)."""
@@ -155,46 +165,46 @@ def result_path(study: Study, scene: str, method: str, seed: int, images: int) -
 
 
 def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:
-    """Trains trunk `trunk` of `seed` on to `upto` images, exporting its model at every budget on the way and at
-    every branch's starting point (budget - adv_images), and scores each budget on the test split."""
+    """Trains trunk `trunk` of `seed` on to N - C for each budget N up to `upto` images, exporting its model there,
+    then finishes each budget's model of the trunk and of its LIP+AD (`finish`) and scores it on the test split."""
     from lipjax.train.loop import export, train
 
     lr = tuned_learning_rate(study, scene, trunk, progress)
     budgets = [b for b in study.budgets_for(scene, seed) if b <= upto]
-    wanted_branches = [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
-    drop_stale_scores(study, scene, [trunk, *wanted_branches], seed, lr)
-    stops = sorted({*budgets, *(b - study.adv_images for b in budgets if wanted_branches)})
+    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    drop_stale_scores(study, scene, methods, seed, lr)
     final = max(study.budgets_for(scene, seed))  # the run's length is fixed by its seed's largest budget
     config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
                                        tiny=study.tiny), study.workers)
     workdir = trunk_workdir(study, scene, trunk, lr, seed)
-    for images in stops:
-        if not _needed(study, scene, trunk, seed, images, budgets, wanted_branches):
+    for budget in budgets:
+        left = [m for m in methods if not result_path(study, scene, m, seed, budget).exists()]
+        if not left:
             continue
-        model = workdir / "models" / str(images)
-        if not model.with_suffix(".msgpack").exists():
+        images = budget - study.cooldown_images(budget)
+        start = workdir / "models" / str(images)
+        if not start.with_suffix(".msgpack").exists():
             state = train(config, workdir, stop_at=images // BATCH, progress=progress)
             if int(state.step) != images // BATCH:
                 raise ValueError(f"{workdir} is at {int(state.step) * BATCH} images, past {images}: a budget "
                                  "added after the run went by it cannot be scored; start another --root")
-            export(config, state, model, {"learning_rate": lr, "schedule": config.schedule, "data": scene})
-        if images in budgets and not result_path(study, scene, trunk, seed, images).exists():
-            score(study, scene, trunk, seed, images, model, lr)
-    for method in wanted_branches:
-        for images in budgets:
-            run_branch(study, scene, method, lr, workdir, seed, images, progress)
+            export(config, state, start, {"learning_rate": lr, "schedule": config.schedule, "data": scene})
+        for method in left:
+            finish(study, scene, method, lr, start, seed, budget, progress)
 
 
 def drop_stale_scores(study: Study, scene: str, methods: list[str], seed: int, lr: float) -> None:
     """Removes the scores of `methods` and `seed` made at a learning rate other than the trunk's tuned `lr` (tuning
-    that went past its grid after they were made): they are made again at `lr`."""
+    that went past its grid after they were made) or with another cool-down share than the study's (scores made
+    before the cool-down was adopted have none): they are made again."""
     for method in methods:
         for path in study.scores_dir(scene).glob(f"{method}-seed{seed}-*.json"):
-            made_at = json.loads(path.read_text()).get("learning_rate")
-            if made_at != lr:
+            doc = json.loads(path.read_text())
+            made = (doc.get("learning_rate"), doc.get("cooldown"))
+            if made != (lr, study.cooldown):
                 path.unlink()
-                print(f"[study] {path} was made at learning rate {made_at}, not the tuned {lr:g}: made again",
-                      flush=True)
+                print(f"[study] {path} was made at learning rate {made[0]} and cool-down {made[1]}, not the tuned "
+                      f"{lr:g} and {study.cooldown:g}: made again", flush=True)
 
 
 def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) -> pathlib.Path:
@@ -209,33 +219,18 @@ def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) ->
     return workdir
 
 
-def _needed(study: Study, scene: str, trunk: str, seed: int, images: int, budgets: list[int],
-            branches: list[str]) -> bool:
-    """Whether the trunk's model at `images` is still wanted: a budget not scored yet, or the start of a branch
-    whose budget is not scored yet."""
-    if images in budgets and not result_path(study, scene, trunk, seed, images).exists():
-        return True
-    return any(images + study.adv_images in budgets and not result_path(study, scene, m, seed,
-                                                                         images + study.adv_images).exists()
-               for m in branches)
-
-
-def run_branch(study: Study, scene: str, method: str, lr: float, trunk_dir: pathlib.Path, seed: int, images: int,
-               progress: bool) -> None:
-    """LIP+AD `method` at `images`: from its trunk's model (run in `trunk_dir`) at images - adv_images
-    (experiments/configs/study.py), at the trunk's learning rate `lr`."""
+def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path, seed: int, budget: int,
+           progress: bool) -> None:
+    """The model of `method` at `budget`: the cool-down (experiments/configs/study.py) of its trunk's model `start`,
+    at the trunk's learning rate `lr`, in <root>/<scene>/<method>/lr<lr>/seed<seed>/<budget>; then its score."""
     from lipjax.train.run import run
 
-    if result_path(study, scene, method, seed, images).exists():
-        return
-    start = trunk_dir / "models" / str(images - study.adv_images)
-    config = with_workers(branch_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
-                                        adv_images=study.adv_images, tiny=study.tiny), study.workers)
-    workdir = study.scene_dir(scene) / method / f"lr{lr:g}" / f"seed{seed}" / str(images)
-    model = workdir / "model"
+    config = with_workers(cooldown_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
+                                          images=study.cooldown_images(budget), tiny=study.tiny), study.workers)
+    model = study.scene_dir(scene) / method / f"lr{lr:g}" / f"seed{seed}" / str(budget) / "model"
     if not model.with_suffix(".msgpack").exists():
-        run(config, workdir, export=model, progress=progress)
-    score(study, scene, method, seed, images, model, lr)
+        run(config, model.parent, export=model, progress=progress)
+    score(study, scene, method, seed, budget, model, lr)
 
 
 def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path, lr: float) -> dict:
@@ -257,6 +252,7 @@ def score(study: Study, scene: str, method: str, seed: int, images: int, model: 
     full = per_k[max(ks)] if ks else evaluate(completer, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                               max_depth_m=protocol.max_depth_m, limit=limit, progress=False)
     doc = {"method": method, "scene": scene, "seed": seed, "images": images, "learning_rate": lr,
+           "cooldown": study.cooldown,
            "images_seen": completer.metadata.get("images_seen"), "model": str(model),
            "rmse_m": full.metrics["rmse_m"], "mae_m": full.metrics["mae_m"], "metrics": full.metrics,
            "per_image": [{"id": p["id"], "rmse_m": p["rmse_m"], "mae_m": p["mae_m"]} for p in full.per_image],
@@ -351,7 +347,9 @@ def main(argv=None) -> None:
     p.add_argument("--curve", type=_ints, help="budgets scored on the way; seed 0 goes on to the largest "
                    "(default: indoor 10000,30000,100000; outdoor none)")
     p.add_argument("--tune-images", type=int, default=3_000)
-    p.add_argument("--adv-images", type=int, default=2_000)
+    p.add_argument("--cooldown", type=float, default=COOLDOWN_FRACTION,
+                   help="the share of each budget that finishes its model, its rate decaying to 0 (default "
+                   "%(default)s)")
     p.add_argument("--methods", help=f"comma-separated, of {','.join(METHODS)} (default: all)")
     p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
     p.add_argument("--root", default="runs/study", help="runs, checkpoints and models (default runs/study)")
@@ -373,7 +371,7 @@ def main(argv=None) -> None:
         study = Study(pathlib.Path(args.root), pathlib.Path(args.scores), scenes,
                       {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
                       args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
-                      args.tune_images, args.adv_images, args.limit, args.tiny, methods, args.workers,
+                      args.tune_images, args.cooldown, args.limit, args.tiny, methods, args.workers,
                       None if args.tiny else WARM_STARTS)
     except ValueError as exc:
         p.error(str(exc))

@@ -8,7 +8,7 @@
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
 # later if anything still runs) in runs/study, going on from the committed tuning and scores
 # (experiments/study_scores, in the working tree that travels), then packs what it finished into OUT: log.txt,
-# scores.tgz (the tuning and scores, and the report) and the exported models at the budget IMAGES, models.tgz.*
+# scores.tgz (the tuning and scores, and the report) and every method's model at the budget IMAGES, models.tgz.*
 # (15 MB parts). Back on the CPU machine:
 #
 #   tar xzf scores.tgz && cat models.tgz.* | tar xzf - -C runs/study      # then commit experiments/study_scores
@@ -29,7 +29,7 @@ if [ -n "${TINY:-}" ]; then
   ROOT=runs/study-tiny
   SCORES=$ROOT/scores
   IMAGES=96
-  ARGS="--tiny --curve 48,96 --tune-images 32 --adv-images 40 --limit 2 --methods ma2018,lip-cnn,lip-ad $ARGS"
+  ARGS="--tiny --curve 48,96 --tune-images 32 --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad $ARGS"
 fi
 LOG=$OUT/log.txt
 mkdir -p "$OUT" "$ROOT"
@@ -42,6 +42,6 @@ echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
 python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" --results "$ROOT/report" --report \
   --images "$IMAGES" $ARGS >> "$LOG" 2>&1
 tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
-(cd "$ROOT" && ls -d */*/lr*/seed*/models/"$IMAGES".* */*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
+(cd "$ROOT" && ls -d */*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
   | split -b 15M - "$OUT/models.tgz.")
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

@@ -18,7 +18,7 @@ import json
 import pathlib
 import sys
 
-from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, branch_config, trunk_config
+from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, trunk_config
 from experiments.equal_budget import SCORES
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.shipped import WEIGHTS_DIR
@@ -42,14 +42,6 @@ def scores_of(scores: pathlib.Path, scene: str, images: int) -> dict[str, dict]:
     return {m: json.loads(p.read_text()) for m, p in paths.items()}
 
 
-def validation_config(method: str, scene: str, learning_rate: float, tiny: bool):
-    """The study config of `method` (validation frames and sampler are the scene base's for every method)."""
-    if method in BRANCHES:
-        return branch_config(method, scene, learning_rate=learning_rate, seed=SEED, init_from="-", adv_images=2000,
-                             tiny=tiny)
-    return trunk_config(method, scene, learning_rate=learning_rate, seed=SEED, steps=1, tiny=tiny)
-
-
 def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = False) -> dict:
     """Writes out/<method>-<scene>.{json,msgpack} from the model of `score`; returns its metadata."""
     from lipjax import model_io
@@ -59,7 +51,8 @@ def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = F
     if meta.get("images_seen") != score["images"]:
         raise ValueError(f"{score['model']} has read {meta.get('images_seen')} images, its score says "
                          f"{score['images']}")
-    config = validation_config(method, scene, score["learning_rate"], tiny)
+    trunk = BRANCHES.get(method, (method,))[0]  # every run of a scene validates on the scene base's frames
+    config = trunk_config(trunk, scene, learning_rate=score["learning_rate"], seed=SEED, steps=1, tiny=tiny)
     val = evaluate_params(model_config, params, validation_batches(config), model_config.max_depth_m)
     meta = {**meta, "train_config": shipped_name(method, scene), "seed": SEED, "val_metrics": val,
             "val_sampler": config.data.val_sampler, "val_images": config.data.val_images,
@@ -70,14 +63,15 @@ def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = F
 
 
 def expected_line(method: str, scene: str, meta: dict) -> str:
-    """The experiments/configs EXPECTED entry of a shipped model's metadata."""
+    """The experiments/configs EXPECTED entry of a shipped model's metadata: its budget is the trunk's images and its
+    cool-down's, which its config alone does not give (it starts from the trunk's model, which is not shipped)."""
     key, images = shipped_name(method, scene).replace("-", "_"), meta["images_seen"]
-    note = ""
-    if method in BRANCHES:  # its config starts from the shipped trunk, which read the whole budget
-        adversarial = meta["steps"] * BASES[scene].batch_size
-        note = (f', budget_from_config=False, note="the study\'s LIP+AD: {BRANCHES[method][0]} seed {SEED} to '
-                f'{images - adversarial:,} images, then {adversarial:,} with D"')
-    return f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}{note}),'
+    cooldown = meta["steps"] * BASES[scene].batch_size
+    trunk = BRANCHES.get(method, (method,))[0]
+    note = (f"the study's seed-{SEED} run: {trunk} at a constant rate to {images - cooldown:,} images, then a "
+            f"{cooldown:,}-image cool-down{' with D' if method in BRANCHES else ''}")
+    return (f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}, '
+            f'budget_from_config=False,\n                   note="{note}"),')
 
 
 def main(argv=None) -> list[str]:

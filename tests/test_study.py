@@ -13,7 +13,7 @@ import lipjax
 from scipy import stats
 
 from experiments import equal_budget, ship_study, study_report
-from experiments.configs.study import BRANCH_SEED_OFFSET, branch_config, trunk_config
+from experiments.configs.study import COOLDOWN_SEED_OFFSET, cooldown_config, cooldown_images, trunk_config
 from lipjax import model_io
 from lipjax.networks import baseline_preset
 from lipjax.train.run import logged_validation
@@ -21,28 +21,31 @@ from lipjax.train.state import g_learning_rate
 
 
 def study(tmp_path, **kw):
-    defaults = dict(warm_starts=None, scenes=("indoor",), seeds={"indoor": (0, 1)}, images=32,
-                    curve={"indoor": (16, 32, 48)},
-                    tune_images=16, adv_images=8, limit=1, tiny=True)
+    defaults = dict(warm_starts=None, scenes=("indoor",), seeds={"indoor": (0, 1)}, images=64,
+                    curve={"indoor": (32, 64, 96)}, tune_images=16, cooldown=0.5, limit=1, tiny=True)
     return equal_budget.Study(tmp_path, tmp_path / "scores", **{**defaults, **kw})
 
 
 def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
     s = study(tmp_path)
-    assert s.budgets_for("indoor", 1) == [16, 32]
-    assert s.budgets_for("indoor", 0) == [16, 32, 48]
+    assert s.budgets_for("indoor", 1) == [32, 64]
+    assert s.budgets_for("indoor", 0) == [32, 64, 96]
     steps = equal_budget.plan(s)
     # every seed reaches B before seed 0 goes on past it
-    first_past_b = next(i for i, step in enumerate(steps) if step[3] > 32)
-    assert all(step[3] == 32 for step in steps[:first_past_b])
-    assert {(t, k) for _, t, k, n in steps if n == 32} == {(t, k) for t in ("ma2018", "unet", "cspn", "lip-cnn",
+    first_past_b = next(i for i, step in enumerate(steps) if step[3] > 64)
+    assert all(step[3] == 64 for step in steps[:first_past_b])
+    assert {(t, k) for _, t, k, n in steps if n == 64} == {(t, k) for t in ("ma2018", "unet", "cspn", "lip-cnn",
                                                                           "lip-fast") for k in (0, 1)}
-    assert [(t, k, n) for _, t, k, n in steps[first_past_b:]] == [(t, 0, 48) for t in ("ma2018", "unet", "cspn",
+    assert [(t, k, n) for _, t, k, n in steps[first_past_b:]] == [(t, 0, 96) for t in ("ma2018", "unet", "cspn",
                                                                                       "lip-cnn", "lip-fast")]
+    assert [s.cooldown_images(b) for b in (32, 64, 96)] == [16, 32, 48]  # whole batches of 8
+    assert [cooldown_images(b) for b in (10_000, 30_000, 100_000)] == [2_000, 6_000, 20_000]  # the default 0.2
     with pytest.raises(ValueError, match="multiples of the batch size"):
         study(tmp_path, images=30)
-    with pytest.raises(ValueError, match="below the smallest budget"):
-        study(tmp_path, adv_images=16)
+    with pytest.raises(ValueError, match="it needs 2 steps"):
+        study(tmp_path, cooldown=0.2)  # 8 of the 32 images: one step
+    with pytest.raises(ValueError, match="must leave some to the trunk"):
+        study(tmp_path, cooldown=1.0)
 
 
 def test_a_run_committed_to_go_on_from_is_copied_to_a_machine_without_it(tmp_path, capsys):
@@ -72,29 +75,41 @@ def test_tuning_goes_past_the_grid_while_its_edge_is_best_and_at_most_two_steps(
     assert study_report.best_rate({**grid, 1.25e-3: 0.5, 3.125e-3: float("nan")}) == 1.25e-3
 
 
-def test_scores_made_at_another_rate_than_the_tuned_one_are_dropped(tmp_path, capsys):
-    s = study(tmp_path)
+def test_scores_made_at_another_rate_or_cool_down_than_the_studys_are_dropped(tmp_path, capsys):
+    s = study(tmp_path)  # cool-down 0.5
     folder = s.scores_dir("indoor")
     folder.mkdir(parents=True)
-    for name, lr in (("unet-seed0-16", 1.25e-3), ("unet-seed0-32", 3.125e-3), ("unet-seed1-16", 1.25e-3),
-                     ("cspn-seed0-16", 1.25e-3)):
-        (folder / f"{name}.json").write_text(json.dumps({"learning_rate": lr}))
+    for name, lr, cooldown in (("unet-seed0-16", 1.25e-3, 0.5), ("unet-seed0-32", 3.125e-3, 0.5),
+                               ("unet-seed0-48", 3.125e-3, None), ("unet-seed1-16", 1.25e-3, 0.5),
+                               ("cspn-seed0-16", 1.25e-3, None)):
+        (folder / f"{name}.json").write_text(json.dumps({"learning_rate": lr, "cooldown": cooldown}))
     equal_budget.drop_stale_scores(s, "indoor", ["unet"], 0, 3.125e-3)
     assert sorted(p.stem for p in folder.glob("*.json")) == ["cspn-seed0-16", "unet-seed0-32", "unet-seed1-16"]
-    assert "not the tuned 0.003125: made again" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "made at learning rate 0.00125 and cool-down 0.5, not the tuned 0.003125 and 0.5" in out
+    assert "made at learning rate 0.003125 and cool-down None" in out
 
 
-def test_a_branch_reads_its_budget_of_images_on_a_stream_of_its_own():
+def test_a_cool_down_decays_the_trunks_rate_to_zero_and_lip_ad_is_lip_cnns_made_adversarial():
     trunk = trunk_config("lip-cnn", "indoor", learning_rate=5e-4, seed=2, steps=3750)
-    branch = branch_config("lip-ad", "indoor", learning_rate=5e-4, seed=2, init_from="start", adv_images=2000)
-    assert (branch.d_steps, branch.adv_steps, branch.g_steps) == (50, 200, 0)  # the paper's LIP+AD split
-    assert branch.total_steps * branch.batch_size == 2000
-    assert branch.seed == 2 + BRANCH_SEED_OFFSET and branch.learning_rate == trunk.learning_rate
-    assert branch.name == "study-lip-ad-indoor" and branch.init_from == "start"
-    assert (branch.model, branch.data, branch.schedule) == (trunk.model, trunk.data, trunk.schedule)  # G as trained
-    fast = branch_config("lip-ad-fast", "indoor", learning_rate=5e-4, seed=0, init_from="start", adv_images=2000)
-    assert fast.name == "study-lip-ad-fast-indoor" and fast.discriminator.inputs == "log_gradients"
+    cnn, ad = (cooldown_config(m, "indoor", learning_rate=5e-4, seed=2, init_from="start", images=6000)
+               for m in ("lip-cnn", "lip-ad"))
+    assert (cnn.g_steps, cnn.d_steps, cnn.adv_steps) == (750, 0, 0) and not cnn.adversarial
+    assert (ad.g_steps, ad.d_steps, ad.adv_steps) == (0, 50, 700)  # D pretrained for the paper's 50 steps
+    for c in (cnn, ad):
+        assert c.total_steps * c.batch_size == 6000 and c.init_from == "start"
+        assert c.seed == 2 + COOLDOWN_SEED_OFFSET  # fresh frames, the same ones for both
+        assert (c.model, c.data, c.learning_rate) == (trunk.model, trunk.data, trunk.learning_rate)
+    lr = g_learning_rate(cnn)  # by G's updates: 750 of LIP+CNN's, 700 of LIP+AD's
+    assert float(lr(20)) == pytest.approx(5e-4) and float(lr(385)) == pytest.approx(2.5e-4)
+    assert float(lr(749)) == pytest.approx(5e-4 / 730, rel=1e-4) and float(lr(750)) == 0.0
+    assert float(g_learning_rate(ad)(699)) == pytest.approx(5e-4 / 680, rel=1e-4)
+    assert (cnn.name, ad.name) == ("study-lip-cnn-indoor", "study-lip-ad-indoor")
+    fast = cooldown_config("lip-ad-fast", "indoor", learning_rate=5e-4, seed=0, init_from="start", images=2000)
+    assert fast.discriminator.inputs == "log_gradients"
     assert fast.model == trunk_config("lip-fast", "indoor", learning_rate=5e-4, seed=0, steps=10).model
+    with pytest.raises(ValueError, match="it needs at least 2"):
+        cooldown_config("unet", "indoor", learning_rate=5e-4, seed=0, init_from="start", images=8)
 
 
 def test_constant_schedule_holds_the_rate_after_warm_up_whatever_the_run_length():
@@ -153,7 +168,7 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     monkeypatch.setattr(equal_budget, "TUNE_EXTENSIONS", 0)  # none past them (next_rate's own test)
     args = ["--tiny", "--root", str(tmp_path / "study"), "--scores", str(tmp_path / "scores"), "--results",
             str(tmp_path / "report"), "--scene", "indoor",
-            "--seeds", "0", "--images", "96", "--curve", "48,96", "--tune-images", "16", "--adv-images", "40",
+            "--seeds", "0", "--images", "96", "--curve", "48,96", "--tune-images", "16", "--cooldown", "0.5",
             "--limit", "2", "--methods", "lip-cnn,lip-ad", "--no-progress"]
     equal_budget.main(args)
     results = tmp_path / "scores" / "indoor"
@@ -168,7 +183,9 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     assert lip["rmse_m_by_iterations"][k] == lip["rmse_m"]
     tuning = json.loads((results / "tuning.json").read_text())["lip-cnn"]
     chosen = min(tuning, key=lambda lr: tuning[lr]["val_rmse_m"])  # the trunk ran at the rate tuning chose
-    assert lipjax.load_model(lip["model"]).metadata["learning_rate"] == float(chosen)
+    start = pathlib.Path(lip["model"]).parents[1] / "models" / "48"  # the trunk's model the cool-down started from
+    assert lipjax.load_model(start).metadata["learning_rate"] == lip["learning_rate"] == float(chosen)
+    assert lipjax.load_model(lip["model"]).metadata["data_streams"][0]["steps"] == 6  # the trunk's 48 images
     report = json.loads((tmp_path / "report" / "equal_budget.json").read_text())
     assert report["indoor"]["lip-ad"]["images"] == 96 and report["indoor"]["lip-ad"]["seeds"] == [0]
     assert set(report["indoor"]) == {"lip-cnn", "lip-ad", "linear", "nearest"}
@@ -204,4 +221,5 @@ def _ships_as_the_papers_methods(tmp_path, results):
     logged = logged_validation(pathlib.Path(score["model"]).parent / "metrics.jsonl", meta["steps"])
     assert meta["val_metrics"]["rmse_m"] == pytest.approx(logged["rmse_m"], rel=1e-6)
     line = ship_study.expected_line("lip-ad", "indoor", meta)
-    assert "images_seen=96, budget_from_config=False" in line and "lip-cnn seed 0 to 56 images, then 40 with D" in line
+    assert "images_seen=96, budget_from_config=False" in line
+    assert "lip-cnn at a constant rate to 48 images, then a 48-image cool-down with D" in line

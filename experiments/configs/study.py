@@ -1,13 +1,17 @@
 """The equal-budget study's methods (experiments/equal_budget.py): every learned method of Tables I and II as one
-trunk config on one scene's data, or as an adversarial branch of a trunk.
+trunk config on one scene's data, and the cool-down that finishes its model at each budget, supervised or (LIP+AD)
+adversarial.
 
 A trunk trains from random weights with a constant learning rate after its warm-up (TrainConfig.schedule
-"constant"), so that its checkpoint at N images is the same model whatever the run's length: one run per seed gives
-every budget of the data-efficiency curve. Every trunk of a scene reads the same frames, crops and samples: the
-scene base's data (experiments/configs/base.py) with the study's seed.
+"constant"), so that its checkpoint at n images is the same model whatever the run's length: one run per seed serves
+every budget of the data-efficiency curve. The model at budget N is the trunk's at N - C (C = COOLDOWN_FRACTION of
+N) cooled down over C more images: the rate warms up again and decays linearly to 0 (schedule "linear";
+warmup-stable-decay), as the methods' own papers end their runs with a decaying rate. Every run of a scene reads the
+same frames, crops and samples: the scene base's data (experiments/configs/base.py) with the study's seed.
 
-A branch is LIP+AD (paper Sec. III-B): from its trunk's model at N - adv_images images, D is pretrained with G
-frozen (BRANCH_D_STEPS steps), then G and D train together for the rest, so that it too has read N images.
+LIP+AD (paper Sec. III-B) is its trunk's cool-down made adversarial: from the same LIP model at N - C, D is
+pretrained with G frozen (FINISH_D_STEPS steps), then G and D train together for the rest, on the frames of the
+trunk's cool-down. LIP+AD and its LIP+CNN then differ only in the adversarial term, and both have read N images.
 """
 from __future__ import annotations
 
@@ -30,12 +34,14 @@ TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
 # fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
 BRANCHES = {"lip-ad": ("lip-cnn", "depth"), "lip-ad-fast": ("lip-fast", "log_gradients")}
 METHODS = TRUNKS + tuple(BRANCHES)
-# D pretraining steps of a branch (at most a fifth of them); the paper's LIP+AD configs use 50 D steps and 200
-# joint steps (2,000 images).
-BRANCH_D_STEPS = 50
-# A branch reads fresh frames: its data stream is seed + BRANCH_SEED_OFFSET (the trunk's own seed would read the
-# trunk's first batches again: a batch is a function of the seed and the step).
-BRANCH_SEED_OFFSET = 1000
+# The cool-down: its share of a budget, its warm-up steps, and D's pretraining steps in LIP+AD's (at most a fifth of
+# them; the paper's LIP+AD configs use 50 D steps and 200 joint steps). It reads fresh frames: its data stream is
+# seed + COOLDOWN_SEED_OFFSET (the trunk's own seed would read the trunk's first batches again: a batch is a
+# function of the seed and the step), the same stream for LIP+CNN's and LIP+AD's.
+COOLDOWN_FRACTION = 0.2
+COOLDOWN_WARMUP_STEPS = 20
+FINISH_D_STEPS = 50
+COOLDOWN_SEED_OFFSET = 1000
 WARMUP_STEPS = 100
 # The tiny variant (tests; a check of the GPU script): tiny networks on 48x64 renders, 32x48 crops.
 TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
@@ -80,21 +86,29 @@ def trunk_config(method: str, scene: str, *, learning_rate: float, seed: int, st
                 eval_every=1250)
 
 
-def branch_config(method: str, scene: str, *, learning_rate: float, seed: int, init_from: str, adv_images: int,
-                  tiny: bool = False, name: str | None = None) -> TrainConfig:
-    """LIP+AD `method` of seed `seed` on `scene`, named `name` (default study-<method>-<scene>), from its trunk's model
-    at `init_from`: BRANCH_D_STEPS steps of D, then the joint steps, in all adv_images images (batch 8) at the
-    trunk's learning rate, on a stream of its own (seed + BRANCH_SEED_OFFSET)."""
-    trunk, inputs = BRANCHES[method]
-    steps = adv_images // BASES[scene].batch_size
-    d_steps = min(BRANCH_D_STEPS, steps // 5)  # a fifth at most: the tiny check's few steps
-    if d_steps < 1:
-        raise ValueError(f"adv_images {adv_images} gives {steps} steps; LIP+AD needs at least 5 (a fifth of them D "
-                         "pretraining, the rest joint steps)")
-    return _run(trunk, scene, tiny, name=name or f"study-{method}-{scene}", init_from=init_from,
-                seed=seed + BRANCH_SEED_OFFSET, learning_rate=learning_rate, g_steps=0, d_steps=d_steps,
-                adv_steps=steps - d_steps, warmup_steps=20, adv_weight=1e-3, eval_every=steps, checkpoint_every=50,
-                discriminator=Discriminator(max_depth_m=SCENE_MAX_DEPTH_M[scene], inputs=inputs))
+def cooldown_config(method: str, scene: str, *, learning_rate: float, seed: int, init_from: str, images: int,
+                    tiny: bool = False, name: str | None = None) -> TrainConfig:
+    """The cool-down of `method` (a trunk, or a LIP+AD of BRANCHES) of seed `seed` on `scene` from its trunk's model
+    at `init_from`, over `images` images (batch 8), named `name` (default study-<method>-<scene>): the trunk's
+    `learning_rate`, warmed up again and decayed linearly to 0; for LIP+AD, FINISH_D_STEPS steps of D first (G
+    frozen), then G and D together."""
+    trunk, inputs = BRANCHES.get(method, (method, None))
+    steps = images // BASES[scene].batch_size
+    if steps < 2:
+        raise ValueError(f"a cool-down of {images} images is {steps} step(s); it needs at least 2")
+    run = dict(name=name or f"study-{method}-{scene}", init_from=init_from, seed=seed + COOLDOWN_SEED_OFFSET,
+               learning_rate=learning_rate, schedule="linear", warmup_steps=COOLDOWN_WARMUP_STEPS, eval_every=steps,
+               checkpoint_every=50)
+    if inputs is None:
+        return _run(trunk, scene, tiny, g_steps=steps, d_steps=0, adv_steps=0, **run)
+    d_steps = max(1, min(FINISH_D_STEPS, steps // 5))
+    return _run(trunk, scene, tiny, g_steps=0, d_steps=d_steps, adv_steps=steps - d_steps, adv_weight=1e-3,
+                discriminator=Discriminator(max_depth_m=SCENE_MAX_DEPTH_M[scene], inputs=inputs), **run)
+
+
+def cooldown_images(budget: int, fraction: float = COOLDOWN_FRACTION, batch: int = 8) -> int:
+    """The cool-down's share of `budget` images, in whole batches."""
+    return int(round(fraction * budget / batch)) * batch
 
 
 def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:

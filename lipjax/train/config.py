@@ -70,8 +70,10 @@ class DataConfig:
 LOSS_SCALES = ("max_depth", "samples")
 # The learning rate of G over a run (lipjax.train.state.g_learning_rate): "cosine" warms up, then decays to 5 % of
 # learning_rate at the run's last step; "constant" warms up, then holds learning_rate, so that the model at step s
-# does not depend on how long the run is (the equal-budget study: one run gives every budget of its curve).
-LR_SCHEDULES = ("cosine", "constant")
+# does not depend on how long the run is (the equal-budget study: one run gives every budget of its curve);
+# "linear" warms up, then decays linearly to 0 over G's updates: the cool-down that finishes a model from a constant
+# run's (warmup-stable-decay, Hagele et al. 2024, arXiv:2405.18392).
+LR_SCHEDULES = ("cosine", "constant", "linear")
 
 
 @dataclasses.dataclass(frozen=True)

@@ -26,10 +26,16 @@ class TrainState:
 
 def g_learning_rate(config: TrainConfig) -> optax.Schedule:
     """G's learning rate by step: a linear warm-up from 0 over `warmup_steps` (at most the run's steps - 1), then
-    `config.schedule`: "cosine" decays to 5 % of learning_rate at the run's last step, "constant" holds it."""
+    `config.schedule`: "cosine" decays to 5 % of learning_rate at the run's last step, "constant" holds it, "linear"
+    decays linearly to 0 at G's last update (the step counts G's updates, g_steps + adv_steps: D's pretraining steps
+    leave G's optimiser alone)."""
     warmup = max(1, min(config.warmup_steps, config.total_steps - 1))
     if config.schedule == "constant":
         return optax.linear_schedule(0.0, config.learning_rate, warmup)
+    if config.schedule == "linear":
+        updates = max(warmup + 1, config.g_steps + config.adv_steps)
+        return optax.join_schedules([optax.linear_schedule(0.0, config.learning_rate, warmup),
+                                     optax.linear_schedule(config.learning_rate, 0.0, updates - warmup)], [warmup])
     return optax.warmup_cosine_decay_schedule(0.0, config.learning_rate, warmup, max(2, config.total_steps),
                                               end_value=0.05 * config.learning_rate)
 
