@@ -104,9 +104,12 @@ def _mean_std(values: list[float], digits: int = 4) -> str:
 
 def markdown(doc: dict, images: int) -> str:
     left = doc["details"]["scores_left"]
+    share = doc["details"]["cooldown"]
     lines = [f"# The equal-budget study ({images:,} training images per run)", "",
              f"Written by `python -m experiments.equal_budget --report`; {len(left)} score(s) of the study still to "
-             "run (`python -m experiments.equal_budget --plan` lists them).", ""]
+             "run (`python -m experiments.equal_budget --plan` lists them). A method's model at N images: its "
+             f"constant-rate run to {1 - share:.0%} of N, then a cool-down over the last {share:.0%} (the rate "
+             "decaying to 0; LIP+AD's adversarial), docs/decisions/0028-equal-budget-study.md.", ""]
     for scene in SCENES:
         summary = doc.get(scene)
         if not summary:
@@ -224,7 +227,7 @@ def write_report(study, scores_left: list[str], out: pathlib.Path | None = None)
     `out` (default: <root>/report)."""
     out = pathlib.Path(out) if out is not None else study.root / "report"
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict = {"details": {"scores_left": scores_left}}
+    doc: dict = {"details": {"scores_left": scores_left, "cooldown": study.cooldown}}
     for scene in SCENES:
         scores = load_scores(study.scores, scene)
         classical_path = study.scores_dir(scene) / "classical.json"
