@@ -30,11 +30,15 @@ experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k> to be continued f
   3. the report (also --report): docs/results/equal_budget.json, docs/results/equal_budget.md, the data-efficiency
      curve and Fig. 4a (RMSE against the ADMM iteration count K over the seeds) as PNGs, and paired tests.
 Order: the tuning and every seed at --images on rooms, then streets, then seed 0 beyond --images (the curve).
+Two processes on disjoint --methods (e.g. the end-to-end networks and the LIP models) may run at once: they share
+the scene's tuning.json under a lock.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+import fcntl
 import json
 import pathlib
 import shutil
@@ -139,8 +143,7 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
     from lipjax.train.loop import evaluate_params, train, validation_batches
 
     path = study.scores_dir(scene) / "tuning.json"
-    table = json.loads(path.read_text()) if path.exists() else {}
-    scores = table.get(trunk, {})
+    scores = (json.loads(path.read_text()) if path.exists() else {}).get(trunk, {})
     while (lr := next_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})) is not None:
         config = trunk_config(trunk, scene, learning_rate=lr, seed=0, steps=study.tune_images // BATCH,
                               tiny=study.tiny)
@@ -148,8 +151,10 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
         state = train(config, study.scene_dir(scene) / "tune" / trunk / f"lr{lr:g}", progress=progress)
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
         scores[f"{lr:g}"] = {"val_rmse_m": val["rmse_m"], "val_mae_m": val["mae_m"], "images": study.tune_images}
-        table[trunk] = scores
-        _write_json(path, table)
+        with _locked(path):  # another study process (--methods) may be adding its trunks' rates
+            table = json.loads(path.read_text()) if path.exists() else {}
+            table[trunk] = scores
+            _write_json(path, table)
         print(f"[study] {scene} {trunk} lr {lr:g}: val rmse_m={val['rmse_m']:.4f}", flush=True)
     return best_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})
 
@@ -327,6 +332,19 @@ def run_study(study: Study, progress: bool = True) -> None:
         score_classical(study, scene)
         run_trunk(study, scene, trunk, seed, upto, progress)
         write_report(study, missing(study))
+
+
+@contextlib.contextmanager
+def _locked(path: pathlib.Path):
+    """An exclusive lock (fcntl) on <path>.lock while the block runs: two study processes on disjoint --methods
+    share the scene's tuning.json."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path.with_name(path.name + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
 
 
 def _write_json(path: pathlib.Path, doc) -> None:

@@ -223,3 +223,29 @@ def _ships_as_the_papers_methods(tmp_path, results):
     line = ship_study.expected_line("lip-ad", "indoor", meta)
     assert "images_seen=96, budget_from_config=False" in line
     assert "lip-cnn at a constant rate to 48 images, then a 48-image cool-down with D" in line
+
+
+def test_tuning_keeps_the_rates_another_study_process_wrote_meanwhile(tmp_path, monkeypatch):
+    """Two study processes on disjoint --methods share a scene's tuning.json: each writes its trunk's rates into the
+    file as it is then, so neither loses the other's."""
+    import lipjax.train.loop as loop
+
+    s = study(tmp_path)
+    path = s.scores_dir("indoor") / "tuning.json"
+    val = {2e-4: 0.5, 5e-4: 0.4, 1.25e-3: 0.6}
+
+    def fake_train(config, workdir, progress):  # meanwhile, the other process tunes lip-cnn
+        table = json.loads(path.read_text()) if path.exists() else {}
+        table.setdefault("lip-cnn", {})[f"{config.learning_rate:g}"] = {"val_rmse_m": 0.3}
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(table))
+        return type("State", (), {"g_params": config.learning_rate})
+
+    monkeypatch.setattr(loop, "train", fake_train)
+    monkeypatch.setattr(loop, "validation_batches", lambda config: [])
+    monkeypatch.setattr(loop, "evaluate_params", lambda model, lr, batches, max_depth: {"rmse_m": val[lr],
+                                                                                        "mae_m": 0.0})
+    assert equal_budget.tuned_learning_rate(s, "indoor", "unet", progress=False) == 5e-4
+    table = json.loads(path.read_text())
+    assert {k: v["val_rmse_m"] for k, v in table["unet"].items()} == {"0.0002": 0.5, "0.0005": 0.4, "0.00125": 0.6}
+    assert set(table["lip-cnn"]) == {"0.0002", "0.0005", "0.00125"}
