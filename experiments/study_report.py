@@ -229,7 +229,8 @@ def write_report(study, scores_left: list[str], out: pathlib.Path | None = None)
     out.mkdir(parents=True, exist_ok=True)
     doc: dict = {"details": {"scores_left": scores_left, "cooldown": study.cooldown}}
     for scene in SCENES:
-        scores = load_scores(study.scores, scene)
+        # a score made another way (before the cool-down; the study remakes it when it gets there) is left out
+        scores = [s for s in load_scores(study.scores, scene) if s.get("cooldown") == study.cooldown]
         classical_path = study.scores_dir(scene) / "classical.json"
         classical = json.loads(classical_path.read_text()) if classical_path.exists() else {}
         if not scores:

@@ -194,10 +194,13 @@ def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, mo
     assert "| lip-cnn | " in md.split("Tuning")[1] and md.count("**") == 2  # what was tried, the chosen rate in bold
     assert (tmp_path / "report" / "equal_budget_curve_indoor.png").stat().st_size > 0
     _ships_as_the_papers_methods(tmp_path, results)
+    stale = {**json.loads((results / "lip-cnn-seed0-96.json").read_text()), "method": "unet", "cooldown": None}
+    (results / "unet-seed0-96.json").write_text(json.dumps(stale))  # made before the cool-down: not reported
     before = {p: p.stat().st_mtime_ns for p in results.glob("*.json")}
     capsys.readouterr()
     equal_budget.main(args)  # everything is done: nothing is trained or scored again
     assert {p: p.stat().st_mtime_ns for p in results.glob("*.json")} == before
+    assert "unet" not in json.loads((tmp_path / "report" / "equal_budget.json").read_text())["indoor"]
     assert "test rmse_m" not in capsys.readouterr().out
 
 
