@@ -77,26 +77,25 @@ def _run(method: str, scene: str, tiny: bool, **fields) -> TrainConfig:
 
 
 def trunk_config(method: str, scene: str, *, learning_rate: float, seed: int, steps: int,
-                 tiny: bool = False, name: str | None = None) -> TrainConfig:
-    """The run of trunk `method` on `scene` for `steps` steps (batch 8), named `name` (default study-<method>-<scene>):
-    the scene base with that model, the constant schedule, checkpoints every 250 steps (2,000 images), validation
-    every 1,250 (10,000 images)."""
-    return _run(method, scene, tiny, name=name or f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate,
+                 tiny: bool = False) -> TrainConfig:
+    """The run study-<method>-<scene> of trunk `method` for `steps` steps (batch 8): the scene base with that model,
+    the constant schedule, checkpoints every 250 steps (2,000 images), validation every 1,250 (10,000 images)."""
+    return _run(method, scene, tiny, name=f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate,
                 g_steps=steps, d_steps=0, adv_steps=0, warmup_steps=WARMUP_STEPS, checkpoint_every=250,
                 eval_every=1250)
 
 
 def cooldown_config(method: str, scene: str, *, learning_rate: float, seed: int, init_from: str, images: int,
-                    tiny: bool = False, name: str | None = None) -> TrainConfig:
+                    tiny: bool = False) -> TrainConfig:
     """The cool-down of `method` (a trunk, or a LIP+AD of BRANCHES) of seed `seed` on `scene` from its trunk's model
-    at `init_from`, over `images` images (batch 8), named `name` (default study-<method>-<scene>): the trunk's
-    `learning_rate`, warmed up again and decayed linearly to 0; for LIP+AD, FINISH_D_STEPS steps of D first (G
-    frozen), then G and D together."""
+    at `init_from`, over `images` images (batch 8), named study-<method>-<scene>: the trunk's `learning_rate`, warmed
+    up again and decayed linearly to 0; for LIP+AD, FINISH_D_STEPS steps of D first (G frozen), then G and D
+    together."""
     trunk, inputs = BRANCHES.get(method, (method, None))
     steps = images // BASES[scene].batch_size
     if steps < 2:
         raise ValueError(f"a cool-down of {images} images is {steps} step(s); it needs at least 2")
-    run = dict(name=name or f"study-{method}-{scene}", init_from=init_from, seed=seed + COOLDOWN_SEED_OFFSET,
+    run = dict(name=f"study-{method}-{scene}", init_from=init_from, seed=seed + COOLDOWN_SEED_OFFSET,
                learning_rate=learning_rate, schedule="linear", warmup_steps=COOLDOWN_WARMUP_STEPS, eval_every=steps,
                checkpoint_every=50)
     if inputs is None:
