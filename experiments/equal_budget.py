@@ -165,8 +165,13 @@ def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
 
 # ---- stage 2: runs and scores ----------------------------------------------------------------------------------
 
+def score_path(scores: pathlib.Path, scene: str, method: str, seed: int, images: int) -> pathlib.Path:
+    """The score of `method`, `seed` at `images` images in the study's scores folder `scores`."""
+    return scores / scene / f"{method}-seed{seed}-{images}.json"
+
+
 def result_path(study: Study, scene: str, method: str, seed: int, images: int) -> pathlib.Path:
-    return study.scores_dir(scene) / f"{method}-seed{seed}-{images}.json"
+    return score_path(study.scores, scene, method, seed, images)
 
 
 def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:

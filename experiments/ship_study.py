@@ -19,7 +19,7 @@ import pathlib
 import sys
 
 from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, trunk_config
-from experiments.equal_budget import SCORES
+from experiments.equal_budget import SCORES, score_path
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.shipped import WEIGHTS_DIR
 
@@ -34,7 +34,7 @@ def shipped_name(method: str, scene: str) -> str:
 
 def scores_of(scores: pathlib.Path, scene: str, images: int) -> dict[str, dict]:
     """method -> its seed-0 score at `images` on `scene`; a one-line ValueError names what is missing."""
-    paths = {m: scores / scene / f"{m}-seed{SEED}-{images}.json" for m in METHODS}
+    paths = {m: score_path(scores, scene, m, SEED, images) for m in METHODS}
     missing = [m for m, p in paths.items() if not p.exists()]
     if missing:
         raise ValueError(f"{scene}: no seed-{SEED} score at {images:,} images for {', '.join(missing)}; run "

@@ -104,11 +104,11 @@ END_TO_END_DEPTH_SCALE = "samples"
 
 
 def end_to_end_model(method: str, max_depth_m: float, preset: str = END_TO_END_PRESET,
-                     depth_scale: str = "max_depth"):
+                     depth_scale: str | None = None):
     """The end-to-end network `method` (a key of END_TO_END_TYPES) at lipjax.networks preset `preset`, seeing depth
-    in units of `depth_scale` (lipjax.networks.common.DEPTH_SCALES)."""
-    return dataclasses.replace(baseline_preset(END_TO_END_TYPES[method], preset, max_depth_m=max_depth_m),
-                               depth_scale=depth_scale)
+    in units of `depth_scale` (lipjax.networks.common.DEPTH_SCALES; None: the network's default)."""
+    model = baseline_preset(END_TO_END_TYPES[method], preset, max_depth_m=max_depth_m)
+    return model if depth_scale is None else dataclasses.replace(model, depth_scale=depth_scale)
 
 
 def fast_model(max_depth_m: float, initial_estimate: str) -> LIPConfig:

@@ -26,7 +26,7 @@ LIP_AD_OUTDOOR = dataclasses.replace(
     learning_rate=2e-4, warmup_steps=20, adv_weight=1e-3, discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M),
 )
 
-def baseline(base: TrainConfig, name: str, method: str, depth_scale: str = "max_depth", **run) -> TrainConfig:
+def baseline(base: TrainConfig, name: str, method: str, depth_scale: str | None = None, **run) -> TrainConfig:
     """The LIP+CNN run of scene `base` (data, batch size, depth loss, steps, schedule; `run`: fields of a real-data
     run) with the end-to-end network `method` (base.END_TO_END_TYPES) seeing depth in units of `depth_scale`.
     Without the inverse-depth term: from random initialisation it diverged."""

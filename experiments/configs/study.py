@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_TYPES, INDOOR, OUTDOOR, end_to_end_model,
-                                      fast_model)
+from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_PRESET, END_TO_END_TYPES, INDOOR, OUTDOOR,
+                                      end_to_end_model, fast_model)
 from lipjax.data.synthetic.dataset import SyntheticDataset
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
@@ -51,8 +51,7 @@ def trunk_model(method: str, scene: str, tiny: bool = False):
     """The model of trunk `method` on `scene` (tiny: the tests' tiny networks)."""
     base, max_depth = BASES[scene], SCENE_MAX_DEPTH_M[scene]
     if method in END_TO_END:
-        return end_to_end_model(method, max_depth, depth_scale=END_TO_END_DEPTH_SCALE,
-                                **({"preset": "tiny"} if tiny else {}))
+        return end_to_end_model(method, max_depth, "tiny" if tiny else END_TO_END_PRESET, END_TO_END_DEPTH_SCALE)
     if method == "lip-cnn":
         return base.model if not tiny else dataclasses.replace(base.model, prior=dataclasses.replace(
             network_preset("tiny", max_depth_m=max_depth), depth_domain=base.model.prior.depth_domain))
