@@ -173,15 +173,17 @@ def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) ->
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
     fig = Figure(figsize=(6, 4), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    for method in METHODS:
+    for method, marker in zip(METHODS, "osD^vPX"):  # a marker each: methods level at a budget stay visible
         if method not in curves:
             continue
         xs = sorted(curves[method], key=int)
         mean = [statistics.mean(curves[method][x]) for x in xs]
-        line, = ax.plot([int(x) for x in xs], mean, marker="o", label=method)
+        line, = ax.plot([int(x) for x in xs], mean, marker=marker, fillstyle="none", label=method)
         lo = [min(curves[method][x]) for x in xs]
         hi = [max(curves[method][x]) for x in xs]
         ax.fill_between([int(x) for x in xs], lo, hi, color=line.get_color(), alpha=0.15)
@@ -190,6 +192,11 @@ def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) ->
             ax.axhline(classical[name]["rmse_m"], color="grey", linestyle=style, label=f"{name} fill")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_xticks(sorted({int(x) for c in curves.values() for x in c}))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2f}"))
+    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2f}"))
     ax.set_xlabel("training images")
     ax.set_ylabel("test RMSE (m), mean over seeds, band min-max")
     ax.set_title(title)
