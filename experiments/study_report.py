@@ -172,7 +172,6 @@ def tuning_table(tuning: dict) -> list[str]:
 def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
     fig = Figure(figsize=(6, 4), dpi=120)
@@ -195,8 +194,9 @@ def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) ->
     ax.set_xticks(sorted({int(x) for c in curves.values() for x in c}))
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.2f}"))
-    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: f"{v:.2f}"))
+    metres = FuncFormatter(lambda v, _: f"{v:.2f}")
+    ax.yaxis.set_major_formatter(metres)
+    ax.yaxis.set_minor_formatter(metres)
     ax.set_xlabel("training images")
     ax.set_ylabel("test RMSE (m), mean over seeds, band min-max")
     ax.set_title(title)
