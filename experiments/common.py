@@ -44,6 +44,19 @@ def parameter_counts(completers: dict[str, Any]) -> dict[str, int | None]:
     return {name: (c.parameter_count() if isinstance(c, Completer) else None) for name, c in completers.items()}
 
 
+def training_images(completers: dict[str, Any]) -> dict[str, int | None]:
+    """Training images each learned method has read (its model file's images_seen: the budget column of the tables,
+    so that rows of unequal budgets show it); None for methods without learned parameters or without the record."""
+    return {name: (c.metadata.get("images_seen") if isinstance(c, Completer) else None)
+            for name, c in completers.items()}
+
+
+def extra_columns(completers: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """The columns the tables add to the metrics: learned parameters (millions) and training images."""
+    params, images = parameter_counts(completers), training_images(completers)
+    return {m: {"params_M": (params[m] / 1e6 if params[m] else None), "train_images": images[m]} for m in completers}
+
+
 def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],
                   columns: Sequence[str], extra_columns: dict[str, dict[str, Any]] | None = None) -> str:
     """Writes out/results.json (aggregated metrics with units in the keys + meta) and out/table.md; returns the
@@ -77,7 +90,7 @@ def _append_columns(table: str, results, extra: dict[str, dict[str, Any]]) -> st
 def _fmt(v) -> str:
     if v is None:
         return "n/a"
-    return f"{v:.3g}" if isinstance(v, float) else str(v)
+    return f"{v:.3g}" if isinstance(v, float) else f"{v:,}" if isinstance(v, int) else str(v)
 
 
 def _finite(x):

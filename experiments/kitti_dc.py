@@ -21,8 +21,8 @@ import sys
 
 from experiments.common import (
     evaluate_methods,
+    extra_columns,
     load_methods,
-    parameter_counts,
     qualitative_figure,
     synthetic_outdoor_test,
     write_results,
@@ -80,15 +80,14 @@ def main(argv=None) -> dict:
     completers = load_methods(methods)
     results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
-    params = parameter_counts(completers)
     n = next(iter(results.values())).num_images
     meta = {"title": f"Table II: {data_name}", "description": f"input {sampler_name}; {n} images; GT in "
-            f"[{protocol.min_depth_m}, {protocol.max_depth_m}] m; RMSE/MAE in mm, iRMSE/iMAE in 1/km, params in M.",
+            f"[{protocol.min_depth_m}, {protocol.max_depth_m}] m; RMSE/MAE in mm, iRMSE/iMAE in 1/km, params in M; "
+            "train_images: the images a learned model was trained on.",
             "dataset": data_name, "protocol": protocol.name, "sampler": sampler_name, "seed": config.seed,
             "num_images": n, "variant": args.variant}
     out = pathlib.Path(args.out)
-    table = write_results(out, results, meta, COLUMNS,
-                          {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
+    table = write_results(out, results, meta, COLUMNS, extra_columns(completers))
     frames = [dataset[i] for i in range(2 if args.variant != "smoke" else 1)]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers, results,
                        max_depth_m=protocol.max_depth_m, max_error_m=5.0, sparse_title=f"input ({sampler_name})")

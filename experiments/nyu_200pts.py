@@ -20,7 +20,7 @@ import dataclasses
 import pathlib
 import sys
 
-from experiments.common import evaluate_methods, load_methods, parameter_counts, qualitative_figure, write_results
+from experiments.common import evaluate_methods, extra_columns, load_methods, qualitative_figure, write_results
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.data.locate import find_data_root, not_found_note
 from lipjax.data.protocols import get_protocol
@@ -91,18 +91,16 @@ def main(argv=None) -> dict:
     completers = load_methods(methods)
     results = evaluate_methods(completers, dataset, sampler, min_depth_m=protocol.min_depth_m,
                                max_depth_m=protocol.max_depth_m, limit=config.limit, seed=config.seed)
-    params = parameter_counts(completers)
     meta = {
         "title": f"Table I: {config.num_points} points, {data_name}",
         "description": f"protocol {protocol.name}; sampler uniform:{config.num_points} (exactly N valid pixels, keyed "
                        f"by frame id, seed {config.seed}); {next(iter(results.values())).num_images} images; metrics "
                        f"per image over valid GT in [{protocol.min_depth_m}, {protocol.max_depth_m}] m, then "
-                       "averaged.",
+                       "averaged; params in M; train_images: the images a learned model was trained on.",
         "dataset": data_name, "protocol": protocol.name, "sampler": f"uniform:{config.num_points}",
         "seed": config.seed, "num_images": next(iter(results.values())).num_images, "variant": args.variant,
     }
-    table = write_results(out, results, meta, COLUMNS,
-                          {m: {"params_M": (c / 1e6 if c else None)} for m, c in params.items()})
+    table = write_results(out, results, meta, COLUMNS, extra_columns(completers))
     frames = [dataset[i] for i in range(min(config.figure_frames, len(dataset)))]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers, results,
                        max_depth_m=protocol.max_depth_m, max_error_m=0.5,

@@ -63,6 +63,24 @@ def test_figures_show_the_three_best_methods_and_the_best_without_learned_weight
     assert key_methods({m: result(r) for m, r in rmse.items()}, completers) == ["a", "b", "linear", "d"]
 
 
+def test_tables_show_each_learned_models_training_images_beside_its_parameters(tmp_path):
+    """Rows of unequal budgets say so: the budget column is the model file's images_seen."""
+    from experiments.common import extra_columns, write_results
+    from lipjax.evaluate import EvalResult
+    from lipjax.inference import Completer
+
+    config = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
+    learned = Completer(config, config.init(jax.random.key(0)), "m", {"images_seen": 30_000})
+    columns = extra_columns({"m": learned, "linear": "fill"})
+    assert columns == {"m": {"params_M": learned.parameter_count() / 1e6, "train_images": 30_000},
+                       "linear": {"params_M": None, "train_images": None}}
+    results = {m: EvalResult(m, {"rmse_m": 0.2}, {}, [], 0.0, 0.0, 1, 0.0, 10.0) for m in columns}
+    table = write_results(tmp_path, results, {}, ["rmse_m"], columns)
+    assert "| params_M | train_images |" in table.splitlines()[0]
+    assert table.splitlines()[2].endswith(" | 30,000 |") and table.splitlines()[3].endswith("| n/a | n/a |")
+    assert json.loads((tmp_path / "results.json").read_text())["methods"]["m"]["train_images"] == 30_000
+
+
 def test_nyu_200pts_runs_on_nyu_when_it_is_on_disk(tmp_path, capsys, no_real_data, monkeypatch):
     """With NYU where the user keeps it ($LIPJAX_NYU_DIR here) and no flag, Table I is measured on NYU."""
     rng = np.random.default_rng(0)
