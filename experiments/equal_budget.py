@@ -45,8 +45,9 @@ import shutil
 import sys
 
 
-from experiments.configs.study import (BRANCHES, COOLDOWN_FRACTION, METHODS, SCENES, TRUNKS, cooldown_config,
-                                      cooldown_images, test_split, trunk_config)
+from experiments.configs.study import (BRANCHES, COOLDOWN_FRACTION, METHODS, SCENES, STUDY_ROOT, TRUNKS,
+                                      cooldown_config, cooldown_images, run_dir, test_split, trunk_config,
+                                      trunk_export)
 from experiments.study_report import best_rate, write_report
 from lipjax.train.config import TrainConfig
 from lipjax.console import ArgumentParser, run_main
@@ -192,7 +193,7 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
         if not left:
             continue
         images = budget - study.cooldown_images(budget)
-        start = workdir / "models" / str(images)
+        start = trunk_export(study.root, scene, trunk, lr, seed, images)
         if not start.with_suffix(".msgpack").exists():
             state = train(config, workdir, stop_at=images // BATCH, progress=progress)
             if int(state.step) != images // BATCH:
@@ -220,9 +221,8 @@ def drop_stale_scores(study: Study, scene: str, methods: list[str], seed: int, l
 def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) -> pathlib.Path:
     """The run's workdir in --root (one per learning rate); on a machine without it, a copy of the one committed
     under study.warm_starts (the run that was in progress when a session ended), if any."""
-    run = pathlib.Path(scene) / trunk / f"lr{lr:g}" / f"seed{seed}"
-    workdir = study.root / run
-    committed = None if study.warm_starts is None else study.warm_starts / run
+    workdir = run_dir(study.root, scene, trunk, lr, seed)
+    committed = None if study.warm_starts is None else run_dir(study.warm_starts, scene, trunk, lr, seed)
     if not workdir.exists() and committed is not None and committed.is_dir():
         shutil.copytree(committed, workdir)
         print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
@@ -237,7 +237,7 @@ def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path
 
     config = with_workers(cooldown_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
                                           images=study.cooldown_images(budget), tiny=study.tiny), study.workers)
-    model = study.scene_dir(scene) / method / f"lr{lr:g}" / f"seed{seed}" / str(budget) / "model"
+    model = run_dir(study.root, scene, method, lr, seed) / str(budget) / "model"
     if not model.with_suffix(".msgpack").exists():
         run(config, model.parent, export=model, progress=progress)
     score(study, scene, method, seed, budget, model, lr)
@@ -375,7 +375,7 @@ def main(argv=None) -> None:
                    "%(default)s)")
     p.add_argument("--methods", help=f"comma-separated, of {','.join(METHODS)} (default: all)")
     p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
-    p.add_argument("--root", default="runs/study", help="runs, checkpoints and models (default runs/study)")
+    p.add_argument("--root", default=STUDY_ROOT, help="runs, checkpoints and models (default %(default)s)")
     p.add_argument("--scores", default=SCORES, help=f"tuning and scores, committed (default {SCORES})")
     p.add_argument("--results", default="docs/results", help="where --report writes (default docs/results)")
     p.add_argument("--workers", type=int, default=1, help="loader processes per run (default 1; 14 on a 16-core "

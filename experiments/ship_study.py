@@ -18,13 +18,12 @@ import json
 import pathlib
 import sys
 
-from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, trunk_config
+from experiments.configs.study import BASES, BRANCHES, METHODS, SCENES, SHIPPED_SEED, shipped_config
 from experiments.equal_budget import SCORES, score_path
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.shipped import WEIGHTS_DIR
 
 PROG = f"python -m {__spec__.name}"
-SEED = 0  # the shipped run of each method
 
 
 def shipped_name(method: str, scene: str) -> str:
@@ -34,10 +33,10 @@ def shipped_name(method: str, scene: str) -> str:
 
 def scores_of(scores: pathlib.Path, scene: str, images: int) -> dict[str, dict]:
     """method -> its seed-0 score at `images` on `scene`; a one-line ValueError names what is missing."""
-    paths = {m: score_path(scores, scene, m, SEED, images) for m in METHODS}
+    paths = {m: score_path(scores, scene, m, SHIPPED_SEED, images) for m in METHODS}
     missing = [m for m, p in paths.items() if not p.exists()]
     if missing:
-        raise ValueError(f"{scene}: no seed-{SEED} score at {images:,} images for {', '.join(missing)}; run "
+        raise ValueError(f"{scene}: no seed-{SHIPPED_SEED} score at {images:,} images for {', '.join(missing)}; run "
                          "`python -m experiments.equal_budget` on to that budget first (--plan lists what is left)")
     return {m: json.loads(p.read_text()) for m, p in paths.items()}
 
@@ -51,10 +50,14 @@ def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = F
     if meta.get("images_seen") != score["images"]:
         raise ValueError(f"{score['model']} has read {meta.get('images_seen')} images, its score says "
                          f"{score['images']}")
-    trunk = BRANCHES.get(method, (method,))[0]  # every run of a scene validates on the scene base's frames
-    config = trunk_config(trunk, scene, learning_rate=score["learning_rate"], seed=SEED, steps=1, tiny=tiny)
+    config = shipped_config(method, scene, learning_rate=score["learning_rate"], budget=score["images"],
+                            cooldown_fraction=score["cooldown"], tiny=tiny)
+    run = meta["data_streams"][-1 if method in BRANCHES else 0]  # the run that config is: the cool-down, the trunk
+    if model_config != config.model or run["steps"] != config.total_steps:
+        raise ValueError(f"{score['model']} is not a run of {config.name}'s config (its model, "
+                         f"{config.total_steps} steps): was the study's code changed since?")
     val = evaluate_params(model_config, params, validation_batches(config), model_config.max_depth_m)
-    meta = {**meta, "train_config": shipped_name(method, scene), "seed": SEED, "val_metrics": val,
+    meta = {**meta, "train_config": shipped_name(method, scene), "seed": SHIPPED_SEED, "val_metrics": val,
             "val_sampler": config.data.val_sampler, "val_images": config.data.val_images,
             "study": {"budget_images": score["images"], "learning_rate": score["learning_rate"],
                       "test_rmse_m": score["rmse_m"], "test_mae_m": score["mae_m"]}}
@@ -68,7 +71,7 @@ def expected_line(method: str, scene: str, meta: dict) -> str:
     key, images = shipped_name(method, scene).replace("-", "_"), meta["images_seen"]
     cooldown = meta["steps"] * BASES[scene].batch_size
     trunk = BRANCHES.get(method, (method,))[0]
-    note = (f"the study's seed-{SEED} run: {trunk} at a constant rate to {images - cooldown:,} images, then a "
+    note = (f"the study's seed-{SHIPPED_SEED} run: {trunk} at a constant rate to {images - cooldown:,} images, then a "
             f"{cooldown:,}-image cool-down{' with D' if method in BRANCHES else ''}")
     return (f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}, '
             f'budget_from_config=False,\n                   note="{note}"),')

@@ -3,6 +3,7 @@ config is at most one `dataclasses.replace` from a scene base, and `--set` overr
 import dataclasses
 import importlib
 import json
+import pathlib
 import re
 import sys
 
@@ -45,6 +46,26 @@ def test_shipped_model_reached_its_configs_expected_result(key):
         assert meta["images_seen"] == started + config.total_steps * config.batch_size
     else:
         assert expected.note  # a budget the config alone does not give is explained
+
+
+def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates():
+    """Table I's learned rows are the equal-budget study's seed-0 models (experiments/configs/paper.py): each config
+    states the rate the study's tuning chose on the validation split (its committed tuning.json), and each shipped
+    model records that rate and the one budget."""
+    from experiments.configs import paper
+    from experiments.configs.study import BRANCHES, METHODS
+    from experiments.equal_budget import SCORES
+    from experiments.study_report import best_rate
+
+    tuning = json.loads((pathlib.Path(SCORES) / "indoor" / "tuning.json").read_text())
+    assert paper.INDOOR_RATES == {trunk: best_rate({float(lr): r["val_rmse_m"] for lr, r in rates.items()})
+                                  for trunk, rates in tuning.items()}
+    for method in METHODS:
+        trunk = BRANCHES.get(method, (method,))[0]
+        meta = model_io.metadata(f"{method}-indoor")
+        assert meta["study"]["learning_rate"] == CONFIGS[f"{method.replace('-', '_')}_indoor"].learning_rate
+        assert meta["study"]["learning_rate"] == paper.INDOOR_RATES[trunk]
+        assert meta["images_seen"] == meta["study"]["budget_images"] == paper.INDOOR_BUDGET and meta["seed"] == 0
 
 
 def _replace_depths(monkeypatch) -> tuple[object, dict[int, tuple[TrainConfig, int, TrainConfig]]]:

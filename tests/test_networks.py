@@ -173,9 +173,10 @@ def test_baseline_training_configs_copy_the_lip_runs():
         scene = key.split("_")[1]
         lip = configs.LIP_CNN_INDOOR if scene == "indoor" else configs.LIP_CNN_OUTDOOR
         assert config.name == key.replace("_", "-")
-        # only name and model differ, and the end-to-end networks train without the inverse-depth term
+        # only name, model and (the study's, rooms) tuned learning rate differ, and the end-to-end networks train
+        # without the inverse-depth term
         assert config.inverse_depth_weight == 0.0
-        same = dataclasses.replace(config, name=lip.name, model=lip.model,
+        same = dataclasses.replace(config, name=lip.name, model=lip.model, learning_rate=lip.learning_rate,
                                    inverse_depth_weight=lip.inverse_depth_weight)
         assert same == lip
         assert config.model.max_depth_m == lip.model.max_depth_m

@@ -13,7 +13,8 @@ import lipjax
 from scipy import stats
 
 from experiments import equal_budget, ship_study, study_report
-from experiments.configs.study import COOLDOWN_SEED_OFFSET, cooldown_config, cooldown_images, trunk_config
+from experiments.configs.study import (COOLDOWN_SEED_OFFSET, cooldown_config, cooldown_images, shipped_config,
+                                      trunk_config)
 from lipjax import model_io
 from lipjax.networks import baseline_preset
 from lipjax.train.run import logged_validation
@@ -220,6 +221,12 @@ def _ships_as_the_papers_methods(tmp_path, results):
             f"{method}-indoor", 0, 96)
         assert shipped["study"] == {"budget_images": 96, "learning_rate": score["learning_rate"],
                                     "test_rmse_m": score["rmse_m"], "test_mae_m": score["mae_m"]}
+        # its named config (experiments/configs): the trunk's run, or LIP+AD's cool-down from the shipped trunk
+        config = shipped_config(method, "indoor", learning_rate=score["learning_rate"], budget=96,
+                                cooldown_fraction=0.5, tiny=True)
+        run = shipped["data_streams"][0 if method == "lip-cnn" else -1]
+        assert (config.name, config.total_steps, config.seed) == (f"{method}-indoor", run["steps"], run["seed"])
+        assert config.init_from == (None if method == "lip-cnn" else "lip-cnn-indoor")
     # the branch validated at its last step while training: the same frames, the same model, the same RMSE
     logged = logged_validation(pathlib.Path(score["model"]).parent / "metrics.jsonl", meta["steps"])
     assert meta["val_metrics"]["rmse_m"] == pytest.approx(logged["rmse_m"], rel=1e-6)

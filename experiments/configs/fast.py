@@ -20,31 +20,18 @@ from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 
-# Scattered points plus 64- and 16-beam LiDAR scan lines on the rooms: a prox trained on scan lines as well beats
-# linear interpolation on more real frames (docs/results.md, "The same models on real frames").
-FAST_INDOOR_SAMPLER = INDOOR_DATA.train_sampler + "|lidar:hdl64,azimuth_step_deg=0.4|lidar:vlp16,azimuth_step_deg=0.4"
-FAST_INDOOR_DATA = dataclasses.replace(INDOOR_DATA, augment=DEFAULT_AUGMENT, train_sampler=FAST_INDOOR_SAMPLER)
 # Zoom >= 1 only outdoors: the renders are no taller than the crop (lipjax.data.augment).
 FAST_OUTDOOR_DATA = dataclasses.replace(OUTDOOR_DATA, augment=DEFAULT_AUGMENT)
-FAST_INDOOR_MODEL = fast_model(INDOOR_MAX_DEPTH_M, INDOOR_INITIAL_ESTIMATE)
 FAST_OUTDOOR_MODEL = fast_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE)
 
-LIP_FAST_INDOOR = dataclasses.replace(
-    INDOOR, name="lip-fast-indoor", model=FAST_INDOOR_MODEL, data=FAST_INDOOR_DATA,
-    g_steps=3500, learning_rate=5e-4, warmup_steps=200, eval_every=500, checkpoint_every=100,
-)
+# Streets: from the fast prox trained on rooms (its 64,000-image model; the rooms' shipped fast-prox models are the
+# equal-budget study's since 2026-12-07: experiments/configs/paper.py).
 LIP_FAST_OUTDOOR = dataclasses.replace(
     OUTDOOR, name="lip-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA, init_from="lip-fast-indoor",
     g_steps=1300, learning_rate=3e-4, warmup_steps=100, eval_every=500, checkpoint_every=100,
 )
 # D sees differences of log depth: on depth / max_depth it stayed at chance. After a run whose cosine schedule has
 # decayed to zero, the joint steps need a small learning rate (at 2e-4 the run ended worse than its start).
-LIP_AD_FAST_INDOOR = dataclasses.replace(
-    INDOOR, name="lip-ad-fast-indoor", model=FAST_INDOOR_MODEL, data=FAST_INDOOR_DATA, init_from="lip-fast-indoor",
-    g_steps=0, d_steps=100, adv_steps=300, learning_rate=5e-5, warmup_steps=20, adv_weight=1e-3,
-    discriminator=Discriminator(max_depth_m=INDOOR_MAX_DEPTH_M, inputs="log_gradients"),
-    eval_every=500, checkpoint_every=100,
-)
 LIP_AD_FAST_OUTDOOR = dataclasses.replace(
     OUTDOOR, name="lip-ad-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA,
     init_from="lip-fast-outdoor",
@@ -62,25 +49,16 @@ LIP_ANY = dataclasses.replace(
 )
 
 CONFIGS: dict[str, TrainConfig] = {
-    "lip_fast_indoor": LIP_FAST_INDOOR,
     "lip_fast_outdoor": LIP_FAST_OUTDOOR,
-    "lip_ad_fast_indoor": LIP_AD_FAST_INDOOR,
     "lip_ad_fast_outdoor": LIP_AD_FAST_OUTDOOR,
     "lip_any": LIP_ANY,
 }
 
 # What the shipped weights reached (lipjax/weights/<name>.json); all trained on --set data.source=rendered.
 EXPECTED: dict[str, Expected] = {
-    "lip_fast_indoor": Expected(
-        val_rmse_m=0.1694342, images_seen=100_000, budget_from_config=False,
-        note="three runs: this config (28,000 images), 4,500 steps from it on scattered samples only (64,000), then "
-             "4,500 steps with scan lines at learning rate 1e-4, exported as the mean of its last 4 checkpoints"),
     "lip_fast_outdoor": Expected(
         val_rmse_m=3.557457, images_seen=74_400, budget_from_config=False,
         note="this config from the 64,000-image lip-fast-indoor (from the shipped one: 110,400 images)"),
-    "lip_ad_fast_indoor": Expected(
-        val_rmse_m=0.1690931, images_seen=103_200,
-        note="this config from the 100,000-image lip-fast-indoor, exported as the mean of its last 3 checkpoints"),
     "lip_ad_fast_outdoor": Expected(val_rmse_m=3.454171, images_seen=77_600),
     "lip_any": Expected(
         val_rmse_m=2.081812, images_seen=1_572_640, budget_from_config=False,

@@ -16,6 +16,8 @@ trunk's cool-down. LIP+AD and its LIP+CNN then differ only in the adversarial te
 from __future__ import annotations
 
 import dataclasses
+import os
+import pathlib
 
 from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_PRESET, END_TO_END_TYPES, INDOOR, OUTDOOR,
                                       end_to_end_model, fast_model)
@@ -43,6 +45,10 @@ COOLDOWN_WARMUP_STEPS = 20
 FINISH_D_STEPS = 50
 COOLDOWN_SEED_OFFSET = 1000
 WARMUP_STEPS = 100
+# The study's runs, checkpoints and models (python -m experiments.equal_budget --root), and the seed whose models are
+# shipped (python -m experiments.ship_study)
+STUDY_ROOT = "runs/study"
+SHIPPED_SEED = 0
 # The tiny variant (tests; a check of the GPU script): tiny networks on 48x64 renders, 32x48 crops.
 TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
 
@@ -76,25 +82,26 @@ def _run(method: str, scene: str, tiny: bool, **fields) -> TrainConfig:
 
 
 def trunk_config(method: str, scene: str, *, learning_rate: float, seed: int, steps: int,
-                 tiny: bool = False) -> TrainConfig:
-    """The run study-<method>-<scene> of trunk `method` for `steps` steps (batch 8): the scene base with that model,
-    the constant schedule, checkpoints every 250 steps (2,000 images), validation every 1,250 (10,000 images)."""
-    return _run(method, scene, tiny, name=f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate,
+                 tiny: bool = False, name: str | None = None) -> TrainConfig:
+    """The run of trunk `method` for `steps` steps (batch 8), named `name` (default study-<method>-<scene>): the
+    scene base with that model, the constant schedule, checkpoints every 250 steps (2,000 images), validation every
+    1,250 (10,000 images)."""
+    return _run(method, scene, tiny, name=name or f"study-{method}-{scene}", seed=seed, learning_rate=learning_rate,
                 g_steps=steps, d_steps=0, adv_steps=0, warmup_steps=WARMUP_STEPS, checkpoint_every=250,
                 eval_every=1250)
 
 
 def cooldown_config(method: str, scene: str, *, learning_rate: float, seed: int, init_from: str, images: int,
-                    tiny: bool = False) -> TrainConfig:
+                    tiny: bool = False, name: str | None = None) -> TrainConfig:
     """The cool-down of `method` (a trunk, or a LIP+AD of BRANCHES) of seed `seed` on `scene` from its trunk's model
-    at `init_from`, over `images` images (batch 8), named study-<method>-<scene>: the trunk's `learning_rate`, warmed
-    up again and decayed linearly to 0; for LIP+AD, FINISH_D_STEPS steps of D first (G frozen), then G and D
-    together."""
+    at `init_from`, over `images` images (batch 8), named `name` (default study-<method>-<scene>): the trunk's
+    `learning_rate`, warmed up again and decayed linearly to 0; for LIP+AD, FINISH_D_STEPS steps of D first (G
+    frozen), then G and D together."""
     trunk, inputs = BRANCHES.get(method, (method, None))
     steps = images // BASES[scene].batch_size
     if steps < 2:
         raise ValueError(f"a cool-down of {images} images is {steps} step(s); it needs at least 2")
-    run = dict(name=f"study-{method}-{scene}", init_from=init_from, seed=seed + COOLDOWN_SEED_OFFSET,
+    run = dict(name=name or f"study-{method}-{scene}", init_from=init_from, seed=seed + COOLDOWN_SEED_OFFSET,
                learning_rate=learning_rate, schedule="linear", warmup_steps=COOLDOWN_WARMUP_STEPS, eval_every=steps,
                checkpoint_every=50)
     if inputs is None:
@@ -109,8 +116,31 @@ def cooldown_images(budget: int, fraction: float = COOLDOWN_FRACTION, batch: int
     return int(round(fraction * budget / batch)) * batch
 
 
-def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:
-    """The synthetic test split of Table I (rooms, 256x320) or Table II (streets, 128x416)."""
-    data: DataConfig = BASES[scene].data
-    h, w = TINY_SIZE if tiny else (data.height, data.width)
-    return SyntheticDataset(scene, "test", height=h, width=w)
+def run_dir(root: str | os.PathLike, scene: str, method: str, learning_rate: float, seed: int) -> pathlib.Path:
+    """The folder of `method`'s runs of `seed` at `learning_rate` on `scene` in the study's `root` (one per rate): a
+    trunk's workdir, whose models/<images> are its exports; a cool-down's <budget>/ (its workdir) and
+    <budget>/model."""
+    return pathlib.Path(root) / scene / method / f"lr{learning_rate:g}" / f"seed{seed}"
+
+
+def trunk_export(root: str | os.PathLike, scene: str, trunk: str, learning_rate: float, seed: int,
+                 images: int) -> pathlib.Path:
+    """Trunk `trunk`'s model at `images` images (the start of the cool-down of the budget it is 80 % of)."""
+    return run_dir(root, scene, trunk, learning_rate, seed) / "models" / str(images)
+
+
+def shipped_config(method: str, scene: str, *, learning_rate: float, budget: int,
+                   cooldown_fraction: float = COOLDOWN_FRACTION, tiny: bool = False) -> TrainConfig:
+    """The named config of the shipped model <method>-<scene> (python -m experiments.ship_study), the study's
+    seed-SHIPPED_SEED model at `budget` images, its trunk trained at the tuned `learning_rate`. A trunk's: its run
+    from random weights to the cool-down's start (budget - C images). A LIP+AD's: its adversarial cool-down over C
+    images from the shipped trunk model <trunk>-<scene> (the study's starts from that trunk's model at budget - C,
+    which is not shipped). The study makes the shipped model exactly, trunk and cool-down:
+    python -m experiments.equal_budget --scene SCENE --seeds 0 --images BUDGET --curve BUDGET --methods METHOD."""
+    trunk, cooldown = BRANCHES.get(method, (method,))[0], cooldown_images(budget, cooldown_fraction)
+    name = f"{method}-{scene}"
+    if method in BRANCHES:
+        return cooldown_config(method, scene, learning_rate=learning_rate, seed=SHIPPED_SEED,
+                               init_from=f"{trunk}-{scene}", images=cooldown, tiny=tiny, name=name)
+    return trunk_config(method, scene, learning_rate=learning_rate, seed=SHIPPED_SEED,
+                        steps=(budget - cooldown) // BASES[scene].batch_size, tiny=tiny, name=name)
