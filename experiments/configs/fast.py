@@ -1,21 +1,21 @@
-"""The shipped default models: the fast prox (lipjax.priors.fast "fast") on pre-rendered scenes, its
-LIP+AD, and lip-any for rooms and streets; each one `dataclasses.replace` of its scene base (base.py).
+"""The fast prox (lipjax.priors.fast "fast") on streets, its LIP+AD, and lip-any, the default model for rooms and
+streets; each one `dataclasses.replace` of its scene base (base.py). The rooms' fast-prox models (lip-fast-indoor,
+lip-ad-fast-indoor) are the equal-budget study's (paper.py).
 
 The prox has a third of the paper-style G's FLOPs per frame and trains ~2.7x faster here, so it trains longer for
 the same CPU time. The runs (commands, overrides, curves): docs/training.md, "How the shipped models were trained" (the
 run history: `git log -p -- docs/training.md`).
 
-    lipjax data render --kind indoor --split train --count 12000 --out runs/data/indoor-train-256x320
-    python -m experiments.train --config lip_fast_indoor --set data.source=rendered \\
-        --set data.root=runs/data/indoor-train-256x320 --export lipjax/weights/lip-fast-indoor
+    lipjax data render --kind outdoor --split train --count 10000 --out runs/data/outdoor-train-128x416
+    python -m experiments.train --config lip_fast_outdoor --set data.source=rendered \\
+        --set data.root=runs/data/outdoor-train-128x416 --export runs/export/lip-fast-outdoor
 """
 from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import (INDOOR, INDOOR_DATA, INDOOR_INITIAL_ESTIMATE, INDOOR_MAX_DEPTH_M, MIXED,
-                                      OUTDOOR, OUTDOOR_DATA, OUTDOOR_INITIAL_ESTIMATE, OUTDOOR_MAX_DEPTH_M, Expected,
-                                      fast_model)
+from experiments.configs.base import (MIXED, OUTDOOR, OUTDOOR_DATA, OUTDOOR_INITIAL_ESTIMATE, OUTDOOR_MAX_DEPTH_M,
+                                      Expected, fast_model)
 from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
