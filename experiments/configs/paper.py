@@ -6,10 +6,11 @@ Rooms (Table I): the shipped models are the equal-budget study's seed-0 models a
 at the learning rate the study's tuning chose on the validation split. A trunk's config (lip_cnn_indoor,
 lip_fast_indoor, the end-to-end networks) is its run from random weights to the cool-down's start; LIP+AD's
 (lip_ad_indoor, lip_ad_fast_indoor) is its adversarial cool-down, here from the shipped trunk model. The study made
-the shipped models, trunk and cool-down, and makes them again exactly:
+the shipped models, trunk and cool-down, and makes them again exactly (it tunes again, in a fresh --scores):
 
-    python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 30000 --methods lip-cnn,lip-ad
-    python -m experiments.train --config lip_cnn_indoor          # the trunk alone: 24,000 images, ~2 h on 2 cores
+    python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 30000 --methods lip-cnn,lip-ad \\
+        --root runs/remake --scores runs/remake/scores
+    python -m experiments.train --config lip_cnn_indoor          # the trunk alone: 24,000 images, ~1.5 h on 2 cores
 
 Streets (Table II): the earlier runs, each one `dataclasses.replace` of the scene base, until the study's streets
 are shipped:

@@ -135,8 +135,8 @@ def shipped_config(method: str, scene: str, *, learning_rate: float, budget: int
     seed-SHIPPED_SEED model at `budget` images, its trunk trained at the tuned `learning_rate`. A trunk's: its run
     from random weights to the cool-down's start (budget - C images). A LIP+AD's: its adversarial cool-down over C
     images from the shipped trunk model <trunk>-<scene> (the study's starts from that trunk's model at budget - C,
-    which is not shipped). The study makes the shipped model exactly, trunk and cool-down:
-    python -m experiments.equal_budget --scene SCENE --seeds 0 --images BUDGET --curve BUDGET --methods METHOD."""
+    which is not shipped). The study makes the shipped model exactly, trunk and cool-down (python -m
+    experiments.equal_budget with --seeds 0 --images BUDGET --curve BUDGET, a fresh --root and --scores)."""
     trunk, cooldown = BRANCHES.get(method, (method,))[0], cooldown_images(budget, cooldown_fraction)
     name = f"{method}-{scene}"
     if method in BRANCHES:
@@ -144,3 +144,10 @@ def shipped_config(method: str, scene: str, *, learning_rate: float, budget: int
                                init_from=f"{trunk}-{scene}", images=cooldown, tiny=tiny, name=name)
     return trunk_config(method, scene, learning_rate=learning_rate, seed=SHIPPED_SEED,
                         steps=(budget - cooldown) // BASES[scene].batch_size, tiny=tiny, name=name)
+
+
+def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:
+    """The synthetic test split of Table I (rooms, 256x320) or Table II (streets, 128x416)."""
+    data: DataConfig = BASES[scene].data
+    h, w = TINY_SIZE if tiny else (data.height, data.width)
+    return SyntheticDataset(scene, "test", height=h, width=w)
