@@ -30,7 +30,7 @@ from lipjax.train.discriminator import Discriminator
 # The study's budget of the shipped rooms models, and each trunk's learning rate: the lowest validation RMSE after
 # 3,000 images (experiments/study_scores/indoor/tuning.json; tests/test_configs.py reads it).
 INDOOR_BUDGET = 30_000
-INDOOR_RATES = {"ma2018": 3.125e-3, "unet": 7.8125e-3, "cspn": 3.125e-3, "lip-cnn": 5e-4, "lip-fast": FAST_RATE}
+INDOOR_RATES = {"ma2018": 3.125e-3, "unet": 7.8125e-3, "cspn": 3.125e-3, "lip-cnn": 5e-4, "lip-fast": 8e-5}
 INDOOR_STUDY = {method: shipped_config(method, "indoor", learning_rate=INDOOR_RATES[BRANCHES.get(method, (method,))[0]],
                                  budget=INDOOR_BUDGET) for method in METHODS}
 
