@@ -36,8 +36,8 @@ def scores_of(scores: pathlib.Path, scene: str, images: int) -> dict[str, dict]:
     paths = {m: score_path(scores, scene, m, SHIPPED_SEED, images) for m in METHODS}
     missing = [m for m, p in paths.items() if not p.exists()]
     if missing:
-        raise ValueError(f"{scene}: no seed-{SHIPPED_SEED} score at {images:,} images for {', '.join(missing)}; run "
-                         "`python -m experiments.equal_budget` on to that budget first (--plan lists what is left)")
+        raise ValueError(f"{scene}: no seed-{SHIPPED_SEED} score at {images:,} images for {', '.join(missing)}; "
+                         "run `python -m experiments.equal_budget` on to that budget first (--plan: what is left)")
     return {m: json.loads(p.read_text()) for m, p in paths.items()}
 
 
@@ -67,12 +67,14 @@ def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = F
 
 def expected_line(method: str, scene: str, meta: dict) -> str:
     """The experiments/configs EXPECTED entry of a shipped model's metadata: its budget is the trunk's images and its
-    cool-down's, which its config alone does not give (it starts from the trunk's model, which is not shipped)."""
+    cool-down's, which its config alone does not give (a trunk's config is the trunk's run; LIP+AD's starts from the
+    shipped trunk model, the study's from the trunk's model before its cool-down)."""
     key, images = shipped_name(method, scene).replace("-", "_"), meta["images_seen"]
     cooldown = meta["steps"] * BASES[scene].batch_size
     trunk = BRANCHES.get(method, (method,))[0]
-    note = (f"the study's seed-{SHIPPED_SEED} run: {trunk} at a constant rate to {images - cooldown:,} images, then a "
-            f"{cooldown:,}-image cool-down{' with D' if method in BRANCHES else ''}")
+    start = "this config" if method not in BRANCHES else f"{trunk}'s trunk"
+    note = (f"the study's seed-{SHIPPED_SEED} run: {start} at a constant rate to {images - cooldown:,} images, then "
+            f"a {cooldown:,}-image cool-down{' with D (this config, from that model)' if method in BRANCHES else ''}")
     return (f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}, '
             f'budget_from_config=False,\n                   note="{note}"),')
 

@@ -24,8 +24,8 @@ from lipjax.train.discriminator import Discriminator
 FAST_OUTDOOR_DATA = dataclasses.replace(OUTDOOR_DATA, augment=DEFAULT_AUGMENT)
 FAST_OUTDOOR_MODEL = fast_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE)
 
-# Streets: from the fast prox trained on rooms (its 64,000-image model; the rooms' shipped fast-prox models are the
-# equal-budget study's since 2026-12-07: experiments/configs/paper.py).
+# Streets: from the fast prox trained on rooms (its 64,000-image model of 2026-11; the rooms' shipped fast-prox
+# models are the equal-budget study's now: experiments/configs/paper.py).
 LIP_FAST_OUTDOOR = dataclasses.replace(
     OUTDOOR, name="lip-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA, init_from="lip-fast-indoor",
     g_steps=1300, learning_rate=3e-4, warmup_steps=100, eval_every=500, checkpoint_every=100,

@@ -8,8 +8,8 @@ lip_fast_indoor, the end-to-end networks) is its run from random weights to the 
 (lip_ad_indoor, lip_ad_fast_indoor) is its adversarial cool-down, here from the shipped trunk model. The study made
 the shipped models, trunk and cool-down, and makes them again exactly (it tunes again, in a fresh --scores):
 
-    python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 30000 --methods lip-cnn,lip-ad \\
-        --root runs/remake --scores runs/remake/scores
+    python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 30000 \\
+        --methods lip-cnn,lip-ad --root runs/remake --scores runs/remake/scores
     python -m experiments.train --config lip_cnn_indoor          # the trunk alone: 24,000 images, ~1.5 h on 2 cores
 
 Streets (Table II): the earlier runs, each one `dataclasses.replace` of the scene base, until the study's streets
@@ -31,8 +31,9 @@ from lipjax.train.discriminator import Discriminator
 # 3,000 images (experiments/study_scores/indoor/tuning.json; tests/test_configs.py reads it).
 INDOOR_BUDGET = 30_000
 INDOOR_RATES = {"ma2018": 3.125e-3, "unet": 7.8125e-3, "cspn": 3.125e-3, "lip-cnn": 5e-4, "lip-fast": 8e-5}
-INDOOR_STUDY = {method: shipped_config(method, "indoor", learning_rate=INDOOR_RATES[BRANCHES.get(method, (method,))[0]],
-                                 budget=INDOOR_BUDGET) for method in METHODS}
+INDOOR_STUDY = {method: shipped_config(method, "indoor", budget=INDOOR_BUDGET,
+                                       learning_rate=INDOOR_RATES[BRANCHES.get(method, (method,))[0]])
+                for method in METHODS}
 
 LIP_CNN_INDOOR = INDOOR_STUDY["lip-cnn"]
 LIP_CNN_OUTDOOR = dataclasses.replace(OUTDOOR, name="lip-cnn-outdoor")
@@ -57,7 +58,8 @@ BASELINE_CONFIGS: dict[str, TrainConfig] = {
 }
 
 CONFIGS: dict[str, TrainConfig] = {
-    **{f"{method.replace('-', '_')}_indoor": INDOOR_STUDY[method] for method in METHODS if method not in END_TO_END_TYPES},
+    **{f"{method.replace('-', '_')}_indoor": INDOOR_STUDY[method]
+       for method in METHODS if method not in END_TO_END_TYPES},
     "lip_cnn_outdoor": LIP_CNN_OUTDOOR,
     "lip_ad_outdoor": LIP_AD_OUTDOOR,
 }
