@@ -104,9 +104,9 @@ class Augment:
 
 # The settings lip-any, the fast prox on streets and `lipjax adapt` train with. Sample noise and outliers are off: a
 # run of the fast prox on rooms with depth_noise=0.005 and outlier_fraction=0.01 (and learning rate 1e-3) did not
-# improve on its linear start in 1,000 steps (val RMSE 0.2143 m at steps 500 and 1000, linear 0.2153); with them off (and
-# 5e-4) it went on to 0.2086 at 1,500. The two changes were made together, so which one mattered is not known (the
-# lip-fast-indoor recipe of 2026-11, `git log -p -- experiments/configs/fast.py`).
+# improve on its linear start in 1,000 steps (val RMSE 0.2143 m at steps 500 and 1000, linear 0.2153); with them
+# off (and 5e-4) it went on to 0.2086 at 1,500. The two changes were made together, so which one mattered is not
+# known (the lip-fast-indoor recipe of 2026-11, `git log -p -- experiments/configs/fast.py`).
 DEFAULT_TRAINING = Augment(zoom=(0.75, 1.33), hflip=True, brightness=0.2, contrast=0.2, saturation=0.2, gamma=0.2,
                            blur_prob=0.2)
 
