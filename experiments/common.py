@@ -51,7 +51,7 @@ def training_images(completers: dict[str, Any]) -> dict[str, int | None]:
             for name, c in completers.items()}
 
 
-def extra_columns(completers: dict[str, Any]) -> dict[str, dict[str, Any]]:
+def model_columns(completers: dict[str, Any]) -> dict[str, dict[str, Any]]:
     """The columns the tables add to the metrics: learned parameters (millions) and training images."""
     params, images = parameter_counts(completers), training_images(completers)
     return {m: {"params_M": (params[m] / 1e6 if params[m] else None), "train_images": images[m]} for m in completers}

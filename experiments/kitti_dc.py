@@ -21,8 +21,8 @@ import sys
 
 from experiments.common import (
     evaluate_methods,
-    extra_columns,
     load_methods,
+    model_columns,
     qualitative_figure,
     synthetic_outdoor_test,
     write_results,
@@ -87,7 +87,7 @@ def main(argv=None) -> dict:
             "dataset": data_name, "protocol": protocol.name, "sampler": sampler_name, "seed": config.seed,
             "num_images": n, "variant": args.variant}
     out = pathlib.Path(args.out)
-    table = write_results(out, results, meta, COLUMNS, extra_columns(completers))
+    table = write_results(out, results, meta, COLUMNS, model_columns(completers))
     frames = [dataset[i] for i in range(2 if args.variant != "smoke" else 1)]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers, results,
                        max_depth_m=protocol.max_depth_m, max_error_m=5.0, sparse_title=f"input ({sampler_name})")

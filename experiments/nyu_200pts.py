@@ -20,7 +20,7 @@ import dataclasses
 import pathlib
 import sys
 
-from experiments.common import evaluate_methods, extra_columns, load_methods, qualitative_figure, write_results
+from experiments.common import evaluate_methods, load_methods, model_columns, qualitative_figure, write_results
 from lipjax.console import ArgumentParser, positive_int, run_main
 from lipjax.data.locate import find_data_root, not_found_note
 from lipjax.data.protocols import get_protocol
@@ -100,7 +100,7 @@ def main(argv=None) -> dict:
         "dataset": data_name, "protocol": protocol.name, "sampler": f"uniform:{config.num_points}",
         "seed": config.seed, "num_images": next(iter(results.values())).num_images, "variant": args.variant,
     }
-    table = write_results(out, results, meta, COLUMNS, extra_columns(completers))
+    table = write_results(out, results, meta, COLUMNS, model_columns(completers))
     frames = [dataset[i] for i in range(min(config.figure_frames, len(dataset)))]
     qualitative_figure(out / "figure.png", frames, [sampler(s, config.seed) for s in frames], completers, results,
                        max_depth_m=protocol.max_depth_m, max_error_m=0.5,

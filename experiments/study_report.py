@@ -206,7 +206,9 @@ def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) ->
     fig.savefig(path)
 
 
-def plot_iterations(path: pathlib.Path, per_k: dict, title: str) -> None:
+def plot_iterations(path: pathlib.Path, per_k: dict, title: str, linear_rmse_m: float | None = None) -> None:
+    """Fig. 4a: each LIP method's test RMSE after its first K iterations (the trained K = 3 solver stopped early),
+    mean and band over the seeds; the linear fill as a dashed line."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -217,8 +219,11 @@ def plot_iterations(path: pathlib.Path, per_k: dict, title: str) -> None:
         ks = sorted(by_k, key=int)
         mean = np.array([statistics.mean(by_k[k]) for k in ks])
         std = np.array([statistics.stdev(by_k[k]) if len(by_k[k]) > 1 else 0.0 for k in ks])
-        line, = ax.plot([int(k) for k in ks], mean, marker="o", label=f"{method} ({len(by_k[ks[0]])} seeds)")
+        n = len(by_k[ks[0]])
+        line, = ax.plot([int(k) for k in ks], mean, marker="o", label=f"{method} ({n} seed{'s' * (n != 1)})")
         ax.fill_between([int(k) for k in ks], mean - std, mean + std, color=line.get_color(), alpha=0.2)
+    if linear_rmse_m is not None:
+        ax.axhline(linear_rmse_m, color="0.4", linestyle="--", linewidth=1, label="linear fill")
     ax.set_xlabel("ADMM iterations K")
     ax.set_ylabel("test RMSE (m), mean ± std over seeds")
     ax.set_xticks(sorted({int(k) for by_k in per_k.values() for k in by_k}))
@@ -257,7 +262,8 @@ def write_report(study, scores_left: list[str], out: pathlib.Path | None = None)
         plot_curve(out / f"equal_budget_curve_{scene}.png", curve(scores), classical, names[scene])
         if doc["details"][scene]["rmse_m_by_iterations"]:
             plot_iterations(out / f"equal_budget_iterations_{scene}.png", doc["details"][scene][
-                "rmse_m_by_iterations"], f"{names[scene]}, {study.images:,} images")
+                "rmse_m_by_iterations"], f"{names[scene]}, {study.images:,} images",
+                classical.get("linear", {}).get("rmse_m"))
     for name, text in (("equal_budget.json", json.dumps(doc, indent=1) + "\n"),
                        ("equal_budget.md", markdown(doc, study.images))):
         with written_whole(out / name) as tmp:

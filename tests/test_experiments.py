@@ -65,13 +65,13 @@ def test_figures_show_the_three_best_methods_and_the_best_without_learned_weight
 
 def test_tables_show_each_learned_models_training_images_beside_its_parameters(tmp_path):
     """Rows of unequal budgets say so: the budget column is the model file's images_seen."""
-    from experiments.common import extra_columns, write_results
+    from experiments.common import model_columns, write_results
     from lipjax.evaluate import EvalResult
     from lipjax.inference import Completer
 
     config = LIPConfig(prior=network_preset("tiny"), num_iterations=1)
     learned = Completer(config, config.init(jax.random.key(0)), "m", {"images_seen": 30_000})
-    columns = extra_columns({"m": learned, "linear": "fill"})
+    columns = model_columns({"m": learned, "linear": "fill"})
     assert columns == {"m": {"params_M": learned.parameter_count() / 1e6, "train_images": 30_000},
                        "linear": {"params_M": None, "train_images": None}}
     results = {m: EvalResult(m, {"rmse_m": 0.2}, {}, [], 0.0, 0.0, 1, 0.0, 10.0) for m in columns}
