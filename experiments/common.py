@@ -39,22 +39,13 @@ def evaluate_methods(
     return results
 
 
-def parameter_counts(completers: dict[str, Any]) -> dict[str, int | None]:
-    """Learned parameters per method (None for methods without learned parameters)."""
-    return {name: (c.parameter_count() if isinstance(c, Completer) else None) for name, c in completers.items()}
-
-
-def training_images(completers: dict[str, Any]) -> dict[str, int | None]:
-    """Training images each learned method has read (its model file's images_seen: the budget column of the tables,
-    so that rows of unequal budgets show it); None for methods without learned parameters or without the record."""
-    return {name: (c.metadata.get("images_seen") if isinstance(c, Completer) else None)
-            for name, c in completers.items()}
-
-
 def model_columns(completers: dict[str, Any]) -> dict[str, dict[str, Any]]:
-    """The columns the tables add to the metrics: learned parameters (millions) and training images."""
-    params, images = parameter_counts(completers), training_images(completers)
-    return {m: {"params_M": (params[m] / 1e6 if params[m] else None), "train_images": images[m]} for m in completers}
+    """The columns the tables add to the metrics: a learned method's parameters (millions) and the training images
+    its model file records (images_seen), so that rows of unequal budgets show theirs; None for methods without
+    learned parameters."""
+    return {name: {"params_M": c.parameter_count() / 1e6, "train_images": c.metadata.get("images_seen")}
+            if isinstance(c, Completer) else {"params_M": None, "train_images": None}
+            for name, c in completers.items()}
 
 
 def write_results(out: pathlib.Path, results: dict[str, EvalResult], meta: dict[str, Any],
