@@ -14,7 +14,7 @@ from __future__ import annotations
 
 # ---- the model
 # lip-any for rooms and streets and every sensor: within 10 % of the per-scene models on Tables I and II (0007)
-#   python -m experiments.nyu_200pts --methods lip-any,lip-ad-fast-indoor,linear
+#   python -m experiments.nyu_200pts --methods lip-any,lip-cnn-indoor,linear
 #   python -m experiments.kitti_dc --methods lip-any,lip-ad-fast-outdoor,linear
 DEFAULT_MODEL = "lip-any"
 

@@ -29,11 +29,11 @@ than the one lipjax trains with, see that module):
      the graph: the same as its JAX result with the nearest fill, get that with
      `lipjax.complete(rgb, sparse, model=nearest_twin(model), cross_check=False)`. "auto" picks nearest for LiDAR
      scan lines, so for scan lines such a model's export equals lipjax.complete; for scattered points it differs
-     from its linear default: on 5 synthetic rooms (480x640, 200 points) lip-fast-indoor's mean RMSE was 0.261 m
-     in the graph against 0.229 m through lipjax.complete, median |difference| 11-67 mm per room (`python -m
-     benchmarks.onnx_check --scattered`). The shipped outdoor models use "nearest": their export equals lipjax.complete
-     on scan lines and, with cross_check=False, on any input (KITTI, 352x1216, HDL-64: median |difference| 0.002 mm,
-     99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
+     from its linear default: on 5 synthetic rooms (480x640, 200 points) the lip-fast-indoor shipped until
+     2026-12-06 had mean RMSE 0.261 m in the graph against 0.229 m through lipjax.complete, median |difference|
+     11-67 mm per room (`python -m benchmarks.onnx_check --scattered`). The shipped outdoor models use "nearest":
+     their export equals lipjax.complete on scan lines and, with cross_check=False, on any input (KITTI, 352x1216,
+     HDL-64: median |difference| 0.002 mm, 99th percentile at most 0.71 mm; benchmarks/onnx_check.py).
   4. the model (its parameters are constants of the graph), max(depth, 0), the bilinear resize back to (H, W)
      (cv2's INTER_LINEAR), the samples' residuals spread over it where the default path spreads them
      (lipjax.spread; with the sigmas of scan lines, or of scattered samples with --scattered), and the measured
