@@ -9,7 +9,7 @@ which names the model it scored). Its weights and training record are kept; its 
 <method>-<scene> (the name experiments/configs gives its config), seed, the validation metrics of that config's
 validation frames (measured here) and "study": the budget, the learning rate and the test RMSE of the study's
 score. A scene ships all of its methods or none: a table of equal budgets or nothing. Printed at the end: the
-experiments/configs EXPECTED lines the shipped files now state.
+experiments/configs EXPECTED lines the shipped files now state (calls to configs.study.shipped_expected).
 """
 from __future__ import annotations
 
@@ -66,17 +66,11 @@ def ship(method: str, scene: str, score: dict, out: pathlib.Path, tiny: bool = F
 
 
 def expected_line(method: str, scene: str, meta: dict) -> str:
-    """The experiments/configs EXPECTED entry of a shipped model's metadata: its budget is the trunk's images and its
-    cool-down's, which its config alone does not give (a trunk's config is the trunk's run; LIP+AD's starts from the
-    shipped trunk model, the study's from the trunk's model before its cool-down)."""
-    key, images = shipped_name(method, scene).replace("-", "_"), meta["images_seen"]
-    cooldown = meta["steps"] * BASES[scene].batch_size
-    trunk = BRANCHES.get(method, (method,))[0]
-    start = "this config" if method not in BRANCHES else f"{trunk}'s trunk"
-    note = (f"the study's seed-{SHIPPED_SEED} run: {start} at a constant rate to {images - cooldown:,} images, then "
-            f"a {cooldown:,}-image cool-down{' with D (this config, from that model)' if method in BRANCHES else ''}")
-    return (f'    "{key}": Expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, images_seen={images:_}, '
-            f'budget_from_config=False,\n                   note="{note}"),')
+    """The experiments/configs EXPECTED entry of a shipped model's metadata (configs.study.shipped_expected)."""
+    key, trunk = shipped_name(method, scene).replace("-", "_"), BRANCHES.get(method, (None,))[0]
+    cooldown, branch = meta["steps"] * BASES[scene].batch_size, f', trunk="{trunk}"' if trunk else ""
+    return (f'    "{key}": shipped_expected(val_rmse_m={meta["val_metrics"]["rmse_m"]:.7g}, '
+            f'images={meta["images_seen"]:_}, cooldown={cooldown:_}{branch}),')
 
 
 def main(argv=None) -> list[str]:

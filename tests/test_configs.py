@@ -51,9 +51,9 @@ def test_shipped_model_reached_its_configs_expected_result(key):
 def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates():
     """Table I's learned rows are the equal-budget study's seed-0 models (experiments/configs/paper.py): each config
     states the rate the study's tuning chose on the validation split (its committed tuning.json), and each shipped
-    model records that rate and the one budget."""
+    model records that rate and the one budget, and its EXPECTED note the cool-down its last run was."""
     from experiments.configs import paper
-    from experiments.configs.study import BRANCHES, METHODS
+    from experiments.configs.study import BASES, BRANCHES, METHODS, shipped_expected
     from experiments.equal_budget import SCORES
     from experiments.study_report import best_rate
 
@@ -66,6 +66,10 @@ def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates():
         assert meta["study"]["learning_rate"] == CONFIGS[f"{method.replace('-', '_')}_indoor"].learning_rate
         assert meta["study"]["learning_rate"] == paper.INDOOR_RATES[trunk]
         assert meta["images_seen"] == meta["study"]["budget_images"] == paper.INDOOR_BUDGET and meta["seed"] == 0
+        cooldown = meta["steps"] * BASES["indoor"].batch_size
+        expected = shipped_expected(meta["val_metrics"]["rmse_m"], meta["images_seen"], cooldown,
+                                    trunk if method in BRANCHES else None)
+        assert EXPECTED[f"{method.replace('-', '_')}_indoor"].note == expected.note
 
 
 def _replace_depths(monkeypatch) -> tuple[object, dict[int, tuple[TrainConfig, int, TrainConfig]]]:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import dataclasses
 
 from experiments.configs.base import END_TO_END_TYPES, OUTDOOR, OUTDOOR_MAX_DEPTH_M, Expected, end_to_end_model
-from experiments.configs.study import BRANCHES, METHODS, shipped_config
+from experiments.configs.study import BRANCHES, METHODS, shipped_config, shipped_expected
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 
@@ -67,27 +67,13 @@ CONFIGS: dict[str, TrainConfig] = {
 # What the shipped weights of these configs reached (lipjax/weights/<name>.json, "val_metrics" and "images_seen");
 # the rooms' entries as `python -m experiments.ship_study --images 30000 --scene indoor` printed them.
 EXPECTED: dict[str, Expected] = {
-    "ma2018_indoor": Expected(val_rmse_m=0.2469129, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: this config at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down"),
-    "unet_indoor": Expected(val_rmse_m=0.2026831, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: this config at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down"),
-    "cspn_indoor": Expected(val_rmse_m=0.1937541, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: this config at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down"),
-    "lip_cnn_indoor": Expected(val_rmse_m=0.1875187, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: this config at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down"),
-    "lip_fast_indoor": Expected(val_rmse_m=0.1940343, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: this config at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down"),
-    "lip_ad_indoor": Expected(val_rmse_m=0.1874051, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: lip-cnn's trunk at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down with D (this config, from that model)"),
-    "lip_ad_fast_indoor": Expected(val_rmse_m=0.1938957, images_seen=30_000, budget_from_config=False,
-                   note="the study's seed-0 run: lip-fast's trunk at a constant rate to 24,000 images, then a "
-                        "6,000-image cool-down with D (this config, from that model)"),
+    "ma2018_indoor": shipped_expected(val_rmse_m=0.2469129, images=30_000, cooldown=6_000),
+    "unet_indoor": shipped_expected(val_rmse_m=0.2026831, images=30_000, cooldown=6_000),
+    "cspn_indoor": shipped_expected(val_rmse_m=0.1937541, images=30_000, cooldown=6_000),
+    "lip_cnn_indoor": shipped_expected(val_rmse_m=0.1875187, images=30_000, cooldown=6_000),
+    "lip_fast_indoor": shipped_expected(val_rmse_m=0.1940343, images=30_000, cooldown=6_000),
+    "lip_ad_indoor": shipped_expected(val_rmse_m=0.1874051, images=30_000, cooldown=6_000, trunk="lip-cnn"),
+    "lip_ad_fast_indoor": shipped_expected(val_rmse_m=0.1938957, images=30_000, cooldown=6_000, trunk="lip-fast"),
     "lip_cnn_outdoor": Expected(val_rmse_m=4.115104, images_seen=7_200),
     "lip_ad_outdoor": Expected(val_rmse_m=4.078569, images_seen=9_200),
     "ma2018_outdoor": Expected(val_rmse_m=7.428356, images_seen=7_200),

@@ -20,7 +20,7 @@ import os
 import pathlib
 
 from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_PRESET, END_TO_END_TYPES, INDOOR, OUTDOOR,
-                                      end_to_end_model, fast_model)
+                                      Expected, end_to_end_model, fast_model)
 from lipjax.data.synthetic.dataset import SyntheticDataset
 from lipjax.interfaces import SCENE_MAX_DEPTH_M
 from lipjax.model import LIPConfig
@@ -151,3 +151,15 @@ def test_split(scene: str, tiny: bool = False) -> SyntheticDataset:
     data: DataConfig = BASES[scene].data
     h, w = TINY_SIZE if tiny else (data.height, data.width)
     return SyntheticDataset(scene, "test", height=h, width=w)
+
+
+def shipped_expected(val_rmse_m: float, images: int, cooldown: int, trunk: str | None = None) -> Expected:
+    """The EXPECTED entry (experiments/configs) of a study model that experiments.ship_study shipped: validation RMSE
+    `val_rmse_m`, `images` training images of which the last `cooldown` a cool-down; `trunk`: a LIP+AD's trunk
+    method, whose model its cool-down (with D) started from. Its config alone does not give that budget (a trunk's
+    config is the trunk's run; a LIP+AD's starts from the shipped trunk model, the study's from the trunk's model
+    before its cool-down), hence the note."""
+    start = f"{trunk}'s trunk" if trunk else "this config"
+    note = (f"the study's seed-{SHIPPED_SEED} run: {start} at a constant rate to {images - cooldown:,} images, then a "
+            f"{cooldown:,}-image cool-down{' with D (this config, from that model)' if trunk else ''}")
+    return Expected(val_rmse_m=val_rmse_m, images_seen=images, budget_from_config=False, note=note)
