@@ -161,7 +161,21 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
     assert got["wilcoxon_p"] == pytest.approx(stats.wilcoxon(x, y).pvalue)
     assert got["ttest_p"] == pytest.approx(stats.ttest_rel(x, y).pvalue)
     assert got["a_better_frames"] == int((x < y).sum()) and got["seeds"] == [0, 1] and got["frames"] == frames
+    low, high = got["diff_interval_m"]
+    assert low < float(np.mean(x - y)) < high < 0 and got["a_better_seeds"] == 2  # b is 0.05 m worse throughout
     assert study_report.paired_test(a, "lip-ad", "unet", 32) is None  # no run of b: no test
+
+
+def test_bootstrap_interval_spans_the_seeds_and_the_frames_it_draws_from():
+    """A difference constant within each seed: every draw's mean is the mean of the seeds it drew, so the interval
+    runs between the draws of the lowest and of the highest seed only; constant throughout: a point."""
+    diff = np.repeat([[0.0], [1.0]], 50, axis=1)  # seed 0: a level with b; seed 1: a 1 m worse on every frame
+    assert study_report.bootstrap_interval(diff) == (0.0, 1.0)  # draws {0,0}, {0,1}, {1,0}, {1,1}: 0, 0.5, 1
+    assert study_report.bootstrap_interval(np.full((3, 20), -0.02)) == pytest.approx((-0.02, -0.02))
+    one_seed = np.linspace(-1.0, 1.0, 101)[None]  # one seed: frames alone, the mean of 101 draws of U-shaped data
+    low, high = study_report.bootstrap_interval(one_seed)
+    sem = one_seed.std() / np.sqrt(101)
+    assert low == pytest.approx(-1.96 * sem, rel=0.1) and high == pytest.approx(1.96 * sem, rel=0.1)
 
 
 def test_tiny_study_resumes_scores_every_budget_and_reports(tmp_path, capsys, monkeypatch):
