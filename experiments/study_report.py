@@ -157,8 +157,8 @@ def markdown(doc: dict, images: int) -> str:
         lines += tuning_table(doc["details"][scene]["tuning_val_rmse_m"])
         tests = doc["details"][scene]["paired_tests"]
         if tests:
-            lines += ["", "| paired test a vs b | seeds | frames | mean RMSE a / b m | a better on frames | Wilcoxon p | "
-                      "t-test p | a better on seeds | a - b m, 95 % over seeds and frames |",
+            lines += ["", "| paired test a vs b | seeds | frames | mean RMSE a / b m | a better on frames | "
+                      "Wilcoxon p | t-test p | a better on seeds | a - b m, 95 % over seeds and frames |",
                       "|---|---|---:|---:|---:|---:|---:|---:|---|"]
             lines += [f"| {t['a']} vs {t['b']} | {','.join(map(str, t['seeds']))} | {t['frames']} | "
                       f"{t['mean_rmse_a_m']:.4f} / {t['mean_rmse_b_m']:.4f} | {t['a_better_frames']} | "
