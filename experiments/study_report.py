@@ -189,12 +189,17 @@ def tuning_table(tuning: dict) -> list[str]:
     return lines
 
 
+def method_colour(method: str) -> str:
+    """A study method's colour, the same in every figure of the report."""
+    return f"C{METHODS.index(method)}"
+
+
 def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) -> None:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import FuncFormatter, NullFormatter
 
-    fig = Figure(figsize=(6, 4), dpi=120)
+    fig = Figure(figsize=(7, 4), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     for method, marker in zip(METHODS, "osD^vPX"):  # a marker each: methods level at a budget stay visible
@@ -202,26 +207,23 @@ def plot_curve(path: pathlib.Path, curves: dict, classical: dict, title: str) ->
             continue
         xs = sorted(curves[method], key=int)
         mean = [statistics.mean(curves[method][x]) for x in xs]
-        line, = ax.plot([int(x) for x in xs], mean, marker=marker, fillstyle="none", label=method)
+        line, = ax.plot([int(x) for x in xs], mean, marker=marker, fillstyle="none", label=method,
+                        color=method_colour(method))
         lo = [min(curves[method][x]) for x in xs]
         hi = [max(curves[method][x]) for x in xs]
         ax.fill_between([int(x) for x in xs], lo, hi, color=line.get_color(), alpha=0.15)
     for name, style in (("linear", "--"), ("nearest", ":")):
         if name in classical:
             ax.axhline(classical[name]["rmse_m"], color="grey", linestyle=style, label=f"{name} fill")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
+    ax.set_xscale("log")  # budgets a factor apart; RMSE on a linear axis, whose ticks a reader can read off
     ax.set_xticks(sorted({int(x) for c in curves.values() for x in c}))
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
     ax.xaxis.set_minor_formatter(NullFormatter())
-    metres = FuncFormatter(lambda v, _: f"{v:.2f}")
-    ax.yaxis.set_major_formatter(metres)
-    ax.yaxis.set_minor_formatter(metres)
     ax.set_xlabel("training images")
     ax.set_ylabel("test RMSE (m), mean over seeds, band min-max")
     ax.set_title(title)
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the curves, not over them
     fig.tight_layout()
     fig.savefig(path)
 
@@ -235,12 +237,13 @@ def plot_iterations(path: pathlib.Path, per_k: dict, title: str, linear_rmse_m: 
     fig = Figure(figsize=(5, 3.6), dpi=120)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
-    for method, by_k in per_k.items():
+    for method, by_k in sorted(per_k.items(), key=lambda item: METHODS.index(item[0])):
         ks = sorted(by_k, key=int)
         mean = np.array([statistics.mean(by_k[k]) for k in ks])
         std = np.array([statistics.stdev(by_k[k]) if len(by_k[k]) > 1 else 0.0 for k in ks])
         n = len(by_k[ks[0]])
-        line, = ax.plot([int(k) for k in ks], mean, marker="o", label=f"{method} ({n} seed{'s' * (n != 1)})")
+        line, = ax.plot([int(k) for k in ks], mean, marker="o", label=f"{method} ({n} seed{'s' * (n != 1)})",
+                        color=method_colour(method))
         ax.fill_between([int(k) for k in ks], mean - std, mean + std, color=line.get_color(), alpha=0.2)
     if linear_rmse_m is not None:
         ax.axhline(linear_rmse_m, color="0.4", linestyle="--", linewidth=1, label="linear fill")
