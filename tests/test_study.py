@@ -172,7 +172,7 @@ def test_bootstrap_interval_spans_the_seeds_and_the_frames_it_draws_from():
     diff = np.repeat([[0.0], [1.0]], 50, axis=1)  # seed 0: a level with b; seed 1: a 1 m worse on every frame
     assert study_report.bootstrap_interval(diff) == (0.0, 1.0)  # draws {0,0}, {0,1}, {1,0}, {1,1}: 0, 0.5, 1
     assert study_report.bootstrap_interval(np.full((3, 20), -0.02)) == pytest.approx((-0.02, -0.02))
-    one_seed = np.linspace(-1.0, 1.0, 101)[None]  # one seed: frames alone; evenly spread data, whose mean has a known SEM
+    one_seed = np.linspace(-1.0, 1.0, 101)[None]  # one seed: frames alone, evenly spread
     low, high = study_report.bootstrap_interval(one_seed)
     sem = one_seed.std() / np.sqrt(101)
     assert low == pytest.approx(-1.96 * sem, rel=0.1) and high == pytest.approx(1.96 * sem, rel=0.1)
