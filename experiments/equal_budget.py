@@ -6,6 +6,7 @@ the tables' synthetic test splits (issue 52).
     python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 10000,30000
     python -m experiments.equal_budget --plan          # what is done and what is left, without running anything
     python -m experiments.equal_budget --report        # docs/results/equal_budget.json, tables, figures, tests
+    python -m experiments.equal_budget --save-in-progress  # at a session's end, the study stopped: what to commit
     python -m experiments.equal_budget --tiny --root /tmp/study --images 96 --curve 48,96 --tune-images 32 \\
         --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames
 
@@ -19,8 +20,9 @@ N is the trunk's at N - C cooled down over C = --cooldown x N more images (the r
 Stages, each skipped when its output exists, so the study continues across sessions and survives any stop (every
 run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
 (experiments/study_scores, committed: a new machine goes on from them); runs, checkpoints and models stay in --root
-(runs/study, not committed) except the run in progress at a session's end, whose workdir may be committed under
-experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k> to be continued from:
+(runs/study, not committed) except the trunk runs in progress at a session's end: --save-in-progress copies each
+(its newest checkpoint and the exports still needed) to experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k>,
+committed once a session, and a new machine continues from there:
   1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS and,
      while the best is the grid's edge, rates beyond it (`next_rate`; seed 0, the validation split: never the test
      split); the same small budget for every trunk;
@@ -144,7 +146,7 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
     from lipjax.train.loop import evaluate_params, train, validation_batches
 
     path = study.scores_dir(scene) / "tuning.json"
-    scores = (json.loads(path.read_text()) if path.exists() else {}).get(trunk, {})
+    scores = _tuning(path).get(trunk, {})
     while (lr := next_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})) is not None:
         config = trunk_config(trunk, scene, learning_rate=lr, seed=0, steps=study.tune_images // BATCH,
                               tiny=study.tiny)
@@ -153,11 +155,23 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
         val = evaluate_params(config.model, state.g_params, validation_batches(config), config.model.max_depth_m)
         scores[f"{lr:g}"] = {"val_rmse_m": val["rmse_m"], "val_mae_m": val["mae_m"], "images": study.tune_images}
         with _locked(path):  # another study process (--methods) may be adding its trunks' rates
-            table = json.loads(path.read_text()) if path.exists() else {}
+            table = _tuning(path)
             table[trunk] = scores
             _write_json(path, table)
         print(f"[study] {scene} {trunk} lr {lr:g}: val rmse_m={val['rmse_m']:.4f}", flush=True)
     return best_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})
+
+
+def tuned_so_far(study: Study, scene: str, trunk: str) -> float | None:
+    """The trunk's tuned learning rate if its tuning is complete, else None (trains nothing)."""
+    scores = _tuning(study.scores_dir(scene) / "tuning.json").get(trunk, {})
+    rmse = {float(k): v["val_rmse_m"] for k, v in scores.items()}
+    return best_rate(rmse) if rmse and next_rate(rmse) is None else None
+
+
+def _tuning(path: pathlib.Path) -> dict:
+    """{trunk: {rate: {"val_rmse_m": ...}}} of a scene's tuning.json (empty before the first rate)."""
+    return json.loads(path.read_text()) if path.exists() else {}
 
 
 def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
@@ -227,6 +241,45 @@ def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) ->
         shutil.copytree(committed, workdir)
         print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
     return workdir
+
+
+def save_in_progress(study: Study) -> list[pathlib.Path]:
+    """Copies each trunk run in --root that the study has not finished into study.warm_starts (the same layout), for
+    a session that keeps only what is committed to go on from (`trunk_workdir`): the run's record and metrics, the
+    exports that its unscored budgets start their cool-downs from, and its newest checkpoint while one of those
+    exports is still ahead of it. Removes the copies of runs finished since. Run it with the study stopped (a
+    checkpoint being written is not yet listed). Returns the runs copied."""
+    from lipjax.train.checkpoint import CheckpointManager
+
+    copied = []
+    for scene, trunk, seed in dict.fromkeys((scene, trunk, seed) for scene, trunk, seed, _ in plan(study)):
+        lr = tuned_so_far(study, scene, trunk)
+        if lr is None or not (workdir := run_dir(study.root, scene, trunk, lr, seed)).is_dir():
+            continue
+        dest = run_dir(study.warm_starts, scene, trunk, lr, seed)
+        methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+        starts = [trunk_export(study.root, scene, trunk, lr, seed, b - study.cooldown_images(b))
+                  for b in study.budgets_for(scene, seed)
+                  if not all(result_path(study, scene, m, seed, b).exists() for m in methods)]
+        step = CheckpointManager(workdir / "checkpoints").latest_step()
+        keep = [s.with_suffix(x) for s in starts for x in (".msgpack", ".json") if s.with_suffix(".msgpack").exists()]
+        if step is not None and not all(s.with_suffix(".msgpack").exists() for s in starts):
+            keep.append(workdir / "checkpoints" / str(step))
+        if dest.exists():
+            shutil.rmtree(dest)
+        if not keep:
+            continue
+        tmp = dest.with_name(dest.name + ".partial")
+        shutil.rmtree(tmp, ignore_errors=True)
+        for path in [p for p in workdir.iterdir() if p.is_file()] + keep:
+            target = tmp / path.relative_to(workdir)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            (shutil.copytree if path.is_dir() else shutil.copy2)(path, target)
+        tmp.rename(dest)
+        copied.append(dest)
+        print(f"[study] {scene} {trunk} seed {seed}: kept in {dest} (" + ", ".join(
+            str(p.relative_to(workdir)) for p in keep) + ")", flush=True)
+    return copied
 
 
 def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path, seed: int, budget: int,
@@ -383,6 +436,8 @@ def main(argv=None) -> None:
     p.add_argument("--tiny", action="store_true", help="tiny networks on 48x64 frames: a check, not a result")
     p.add_argument("--plan", action="store_true", help="print what is done and what is left; run nothing")
     p.add_argument("--report", action="store_true", help="write the report from the scores so far; train nothing")
+    p.add_argument("--save-in-progress", action="store_true", help=f"copy the runs not finished to {WARM_STARTS} "
+                   "(commit it at a session's end: a new machine goes on from there); train nothing")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
     scenes = SCENES if args.scene == "both" else (args.scene,)
@@ -403,6 +458,11 @@ def main(argv=None) -> None:
         print("\n".join(f"{s} {t} seed {k} up to {n} images" + (" (done)" if _done(study, s, t, k, n) else "")
                         for s, t, k, n in plan(study)))
         print(f"{len(left)} scores left" + "".join(f"\n  {line}" for line in left))
+        return
+    if args.save_in_progress:
+        if study.warm_starts is None:
+            p.error("--tiny runs are checks, not kept: --save-in-progress keeps the study's runs")
+        save_in_progress(study)
         return
     enable_compilation_cache()
     if not args.report:

@@ -63,6 +63,43 @@ def test_a_run_committed_to_go_on_from_is_copied_to_a_machine_without_it(tmp_pat
     assert not equal_budget.trunk_workdir(study(tmp_path, warm_starts=None), "indoor", "unet", 1.25e-3, 2).exists()
 
 
+def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_still_needed(tmp_path):
+    from lipjax.train.checkpoint import CheckpointManager
+
+    s = study(tmp_path / "a", warm_starts=tmp_path / "warm", methods=("unet",))
+    tuning = {"unet": {"0.0002": {"val_rmse_m": 0.6}, "0.0005": {"val_rmse_m": 0.5}, "0.00125": {"val_rmse_m": 0.7}}}
+    (s.scores / "indoor").mkdir(parents=True)
+    (s.scores / "indoor" / "tuning.json").write_text(json.dumps(tuning))
+    runs = {k: equal_budget.run_dir(s.root, "indoor", "unet", 5e-4, k) for k in (0, 1)}
+    for k, workdir in runs.items():
+        (workdir / "models").mkdir(parents=True)
+        (workdir / "run.json").write_text(json.dumps({"seed": k}))
+        for step in (1, 2, 3):
+            CheckpointManager(workdir / "checkpoints").save(step, {"w": np.full(2, float(step))}, {"step": step})
+        for images in (16, 32, 48):  # the trunks' models at 32 - 16, 64 - 32 and 96 - 48 images (cool-down 0.5)
+            for suffix in (".msgpack", ".json"):
+                (workdir / "models" / f"{images}{suffix}").write_text(str(images))
+    (runs[1] / "models" / "32.msgpack").unlink()  # seed 1 has not reached the start of budget 64's cool-down
+    for k, budgets in ((0, (32, 64, 96)), (1, (32,))):  # seed 0 finished; seed 1 scored at 32, not at 64
+        for b in budgets:
+            equal_budget._write_json(equal_budget.result_path(s, "indoor", "unet", k, b), {})
+    stale = equal_budget.run_dir(s.warm_starts, "indoor", "unet", 5e-4, 0)
+    (stale / "checkpoints").mkdir(parents=True)  # kept by an earlier session, finished since
+
+    kept = equal_budget.save_in_progress(s)
+    assert kept == [equal_budget.run_dir(s.warm_starts, "indoor", "unet", 5e-4, 1)] and not stale.exists()
+    assert sorted(str(p.relative_to(kept[0])) for p in kept[0].glob("*/*")) == ["checkpoints/3"]
+    assert sorted(p.name for p in kept[0].iterdir()) == ["checkpoints", "run.json"]  # model 16: its budget is scored
+    # a new machine (another --root) goes on from the copy: the newest checkpoint restores
+    workdir = equal_budget.trunk_workdir(dataclasses.replace(s, root=tmp_path / "b"), "indoor", "unet", 5e-4, 1)
+    state, meta = CheckpointManager(workdir / "checkpoints").restore({"w": np.zeros(2)})
+    assert meta == {"step": 3} and state["w"].tolist() == [3.0, 3.0]
+    # once the trunk has made its last export, that export is kept and the checkpoint is not
+    (runs[1] / "models" / "32.msgpack").write_text("32")
+    equal_budget.save_in_progress(s)
+    assert sorted(p.name for p in kept[0].rglob("*")) == ["32.json", "32.msgpack", "models", "run.json"]
+
+
 def test_tuning_goes_past_the_grid_while_its_edge_is_best_and_at_most_two_steps():
     grid = dict.fromkeys(equal_budget.TUNE_LRS, 1.0)
     assert equal_budget.next_rate({}) == 2e-4 and equal_budget.next_rate({2e-4: 1.0}) == 5e-4
