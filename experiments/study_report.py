@@ -82,13 +82,26 @@ def paired_test(scores: list[dict], a: str, b: str, images: int) -> dict | None:
         return None
     x, y = rmse_a.mean(axis=0), rmse_b.mean(axis=0)
     diff = x - y
-    return {"a": a, "b": b, "images": images, "seeds": seeds, "frames": int(len(x)),
+    test = {"a": a, "b": b, "images": images, "seeds": seeds, "frames": int(len(x)),
             "mean_rmse_a_m": float(x.mean()), "mean_rmse_b_m": float(y.mean()),
             "a_better_frames": int((diff < 0).sum()), "b_better_frames": int((diff > 0).sum()),
             "a_better_seeds": int((rmse_a.mean(axis=1) < rmse_b.mean(axis=1)).sum()),
             "diff_interval_m": list(bootstrap_interval(rmse_a - rmse_b)),
             "wilcoxon_p": float(stats.wilcoxon(x, y).pvalue) if np.any(diff) else 1.0,
             "ttest_p": float(stats.ttest_rel(x, y).pvalue) if np.any(diff) else 1.0}
+    test["verdict"] = verdict(test)
+    return test
+
+
+def verdict(test: dict) -> str:
+    """The rule fixed in decision 0028: a method leads where the 95 % interval of mean RMSE a - b excludes 0 and it
+    is better on every seed; otherwise the study does not separate the two."""
+    low, high = test["diff_interval_m"]
+    if high < 0 and test["a_better_seeds"] == len(test["seeds"]):
+        return f"{test['a']} leads"
+    if low > 0 and test["a_better_seeds"] == 0:
+        return f"{test['b']} leads"
+    return "not separated"
 
 
 def best_end_to_end(summary: dict) -> str | None:
@@ -158,12 +171,13 @@ def markdown(doc: dict, images: int) -> str:
         tests = doc["details"][scene]["paired_tests"]
         if tests:
             lines += ["", "| paired test a vs b | seeds | frames | mean RMSE a / b m | a better on frames | "
-                      "Wilcoxon p | t-test p | a better on seeds | a - b m, 95 % over seeds and frames |",
-                      "|---|---|---:|---:|---:|---:|---:|---:|---|"]
+                      "Wilcoxon p | t-test p | a better on seeds | a - b m, 95 % over seeds and frames | verdict |",
+                      "|---|---|---:|---:|---:|---:|---:|---:|---|---|"]
             lines += [f"| {t['a']} vs {t['b']} | {','.join(map(str, t['seeds']))} | {t['frames']} | "
                       f"{t['mean_rmse_a_m']:.4f} / {t['mean_rmse_b_m']:.4f} | {t['a_better_frames']} | "
                       f"{t['wilcoxon_p']:.2g} | {t['ttest_p']:.2g} | {t['a_better_seeds']} of {len(t['seeds'])} | "
-                      f"{t['diff_interval_m'][0]:+.4f} to {t['diff_interval_m'][1]:+.4f} |" for t in tests]
+                      f"{t['diff_interval_m'][0]:+.4f} to {t['diff_interval_m'][1]:+.4f} | {t['verdict']} |"
+                      for t in tests]
         lines.append("")
     return "\n".join(lines)
 

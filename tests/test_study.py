@@ -200,7 +200,21 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
     assert got["a_better_frames"] == int((x < y).sum()) and got["seeds"] == [0, 1] and got["frames"] == frames
     low, high = got["diff_interval_m"]
     assert low < float(np.mean(x - y)) < high < 0 and got["a_better_seeds"] == 2  # b is 0.05 m worse throughout
+    assert got["verdict"] == "lip-ad leads"
     assert study_report.paired_test(a, "lip-ad", "unet", 32) is None  # no run of b: no test
+
+
+def test_the_verdict_is_decision_0028s_rule_interval_excluding_zero_and_every_seed():
+    def verdict(low, high, better_seeds, seeds=3):
+        return study_report.verdict({"a": "lip-ad", "b": "cspn", "diff_interval_m": [low, high],
+                                     "a_better_seeds": better_seeds, "seeds": list(range(seeds))})
+
+    assert verdict(-0.010, -0.001, 3) == "lip-ad leads"
+    assert verdict(0.001, 0.010, 0) == "cspn leads"
+    assert verdict(-0.010, -0.001, 2) == "not separated"  # the interval excludes 0 but one seed goes the other way
+    assert verdict(0.001, 0.010, 1) == "not separated"
+    assert verdict(-0.013, 0.001, 3) == "not separated"  # better on every seed, but the interval holds 0
+    assert verdict(0.0, 0.010, 0) == "not separated"  # 0 itself is not excluded
 
 
 def test_bootstrap_interval_spans_the_seeds_and_the_frames_it_draws_from():
