@@ -204,6 +204,19 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
     assert study_report.paired_test(a, "lip-ad", "unet", 32) is None  # no run of b: no test
 
 
+def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
+    points = {(0, 10_000): 0.30, (0, 30_000): 0.24, (0, 100_000): 0.216, (1, 10_000): 0.20, (1, 30_000): 0.18,
+              (2, 10_000): 0.50}  # seed 2 not yet at 30,000: it must not pull the 10,000 -> 30,000 step
+    scores = [{"method": "unet", "seed": k, "images": n, "rmse_m": v} for (k, n), v in points.items()]
+    change = study_report.curve_change(scores)["unet"]
+    assert change["30000"]["from"] == 10_000 and change["30000"]["seeds"] == [0, 1]
+    assert change["30000"]["change"] == pytest.approx((-0.20 - 0.10) / 2)
+    assert change["100000"] == {"from": 30_000, "seeds": [0], "change": pytest.approx(-0.10)}
+    assert "10000" not in change
+    text = study_report._curve_text({"10000": [0.3, 0.2, 0.5], "30000": [0.24, 0.18]}, change)
+    assert text == "10,000: 0.333, 30,000: 0.210 (-15%)"
+
+
 def test_the_verdict_is_decision_0028s_rule_interval_excluding_zero_and_every_seed():
     def verdict(low, high, better_seeds, seeds=3):
         return study_report.verdict({"a": "lip-ad", "b": "cspn", "diff_interval_m": [low, high],
