@@ -430,7 +430,8 @@ def main(argv=None) -> None:
     p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
     p.add_argument("--root", default=STUDY_ROOT, help="runs, checkpoints and models (default %(default)s)")
     p.add_argument("--scores", default=SCORES, help=f"tuning and scores, committed (default {SCORES})")
-    p.add_argument("--results", default="docs/results", help="where --report writes (default docs/results)")
+    p.add_argument("--results", help="where the report goes when the study ends or with --report (default "
+                   "docs/results; with --tiny, <root>/report: a check never writes the committed results)")
     p.add_argument("--workers", type=int, default=1, help="loader processes per run (default 1; 14 on a 16-core "
                    "GPU host)")
     p.add_argument("--tiny", action="store_true", help="tiny networks on 48x64 frames: a check, not a result")
@@ -462,12 +463,15 @@ def main(argv=None) -> None:
     if args.save_in_progress:
         if study.warm_starts is None:
             p.error("--tiny runs are checks, not kept: --save-in-progress keeps the study's runs")
-        save_in_progress(study)
+        kept = save_in_progress(study)
+        print(f"[study] {len(kept)} run(s) in progress kept in {WARM_STARTS}: commit it (git add {WARM_STARTS})"
+              if kept else "[study] no run in progress to keep")
         return
     enable_compilation_cache()
     if not args.report:
         run_study(study, progress=not args.no_progress)
-    write_report(study, missing(study), pathlib.Path(args.results))
+    write_report(study, missing(study), pathlib.Path(args.results or (study.root / "report" if args.tiny
+                                                                      else "docs/results")))
 
 
 if __name__ == "__main__":

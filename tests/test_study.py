@@ -100,6 +100,13 @@ def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_
     assert sorted(p.name for p in kept[0].rglob("*")) == ["32.json", "32.msgpack", "models", "run.json"]
 
 
+def test_a_tiny_check_reports_into_its_root_never_into_the_committed_results(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # the committed results' relative path would land here
+    equal_budget.main(["--tiny", "--report", "--root", "check", "--scores", "scores", "--images", "96",
+                       "--curve", "48,96", "--tune-images", "32", "--cooldown", "0.5"])
+    assert (tmp_path / "check" / "report" / "equal_budget.md").exists() and not (tmp_path / "docs").exists()
+
+
 def test_tuning_goes_past_the_grid_while_its_edge_is_best_and_at_most_two_steps():
     grid = dict.fromkeys(equal_budget.TUNE_LRS, 1.0)
     assert equal_budget.next_rate({}) == 2e-4 and equal_budget.next_rate({2e-4: 1.0}) == 5e-4
