@@ -136,7 +136,7 @@ def curve_change(scores: list[dict]) -> dict:
 
 
 def _curve_text(points: dict, changes: dict) -> str:
-    """'10,000: 0.229, 30,000: 0.201 (-12 %)': the mean RMSE at each budget, and its change from the budget before."""
+    """'10,000: 0.229, 30,000: 0.201 (-12%)': the mean RMSE at each budget, and its change from the budget before."""
     text = []
     for n, values in sorted(points.items(), key=lambda kv: int(kv[0])):
         change = changes.get(n)
