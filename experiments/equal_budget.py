@@ -4,11 +4,12 @@ the tables' synthetic test splits (issue 52).
 
     python -m experiments.equal_budget                 # the whole study; resumes where it stopped
     python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 10000,30000
-    python -m experiments.equal_budget --plan          # what is done and what is left, without running anything
+    python -m experiments.equal_budget --plan          # what is done and left, and the hours left; runs nothing
     python -m experiments.equal_budget --report        # docs/results/equal_budget.json, tables, figures, tests
     python -m experiments.equal_budget --save-in-progress  # at a session's end, the study stopped: what to commit
     python -m experiments.equal_budget --tiny --root /tmp/study --images 96 --curve 48,96 --tune-images 32 \\
-        --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames
+        --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad   # a check: tiny networks on 48x64 frames,
+                                                                     # its scores and report in /tmp/study
 
 Methods (experiments/configs/study.py): Ma et al. (ma2018), U-Net, CSPN, LIP+CNN with the paper's prox (lip-cnn),
 LIP with the fast prox (lip-fast), and LIP+AD of each (lip-ad, lip-ad-fast: their trunk's cool-down made
@@ -41,6 +42,7 @@ import argparse
 import contextlib
 import dataclasses
 import fcntl
+import functools
 import json
 import pathlib
 import shutil
@@ -146,7 +148,7 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
     from lipjax.train.loop import evaluate_params, train, validation_batches
 
     path = study.scores_dir(scene) / "tuning.json"
-    scores = _tuning(path).get(trunk, {})
+    scores = _tried(study, scene, trunk)
     while (lr := next_rate({float(k): v["val_rmse_m"] for k, v in scores.items()})) is not None:
         config = trunk_config(trunk, scene, learning_rate=lr, seed=0, steps=study.tune_images // BATCH,
                               tiny=study.tiny)
@@ -164,7 +166,7 @@ def tuned_learning_rate(study: Study, scene: str, trunk: str, progress: bool) ->
 
 def tuned_so_far(study: Study, scene: str, trunk: str) -> float | None:
     """The trunk's tuned learning rate if its tuning is complete, else None (trains nothing)."""
-    scores = _tuning(study.scores_dir(scene) / "tuning.json").get(trunk, {})
+    scores = _tried(study, scene, trunk)
     rmse = {float(k): v["val_rmse_m"] for k, v in scores.items()}
     return best_rate(rmse) if rmse and next_rate(rmse) is None else None
 
@@ -172,6 +174,13 @@ def tuned_so_far(study: Study, scene: str, trunk: str) -> float | None:
 def _tuning(path: pathlib.Path) -> dict:
     """{trunk: {rate: {"val_rmse_m": ...}}} of a scene's tuning.json (empty before the first rate)."""
     return json.loads(path.read_text()) if path.exists() else {}
+
+
+def _tried(study: Study, scene: str, trunk: str) -> dict:
+    """{rate: score} of the rates tuning has tried for `trunk` after this study's --tune-images (a rate tried after
+    another count is tried again)."""
+    tried = _tuning(study.scores_dir(scene) / "tuning.json").get(trunk, {})
+    return {rate: v for rate, v in tried.items() if v.get("images") == study.tune_images}
 
 
 def with_workers(config: TrainConfig, workers: int) -> TrainConfig:
@@ -189,6 +198,20 @@ def result_path(study: Study, scene: str, method: str, seed: int, images: int) -
     return score_path(study.scores, scene, method, seed, images)
 
 
+def scored(study: Study, scene: str, method: str, seed: int, images: int) -> bool:
+    """Whether `method` of `seed` has its score at `images` made the study's way (`current`)."""
+    path = result_path(study, scene, method, seed, images)
+    return path.exists() and current(study, json.loads(path.read_text()))
+
+
+def current(study: Study, doc: dict) -> bool:
+    """Whether score `doc` was made the study's way: at its trunk's tuned learning rate (tuning complete) and with
+    the study's cool-down share. The others are left out of the report and made again (`drop_stale_scores`)."""
+    trunk = BRANCHES.get(doc.get("method"), (doc.get("method"),))[0]
+    made = (doc.get("learning_rate"), doc.get("cooldown"))
+    return made == (tuned_so_far(study, doc.get("scene"), trunk), study.cooldown)
+
+
 def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:
     """Trains trunk `trunk` of `seed` on to N - C for each budget N up to `upto` images, exporting its model there,
     then finishes each budget's model of the trunk and of its LIP+AD (`finish`) and scores it on the test split."""
@@ -203,7 +226,7 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
                                        tiny=study.tiny), study.workers)
     workdir = trunk_workdir(study, scene, trunk, lr, seed)
     for budget in budgets:
-        left = [m for m in methods if not result_path(study, scene, m, seed, budget).exists()]
+        left = [m for m in methods if not scored(study, scene, m, seed, budget)]
         if not left:
             continue
         images = budget - study.cooldown_images(budget)
@@ -260,7 +283,7 @@ def save_in_progress(study: Study) -> list[pathlib.Path]:
         methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
         starts = [trunk_export(study.root, scene, trunk, lr, seed, b - study.cooldown_images(b))
                   for b in study.budgets_for(scene, seed)
-                  if not all(result_path(study, scene, m, seed, b).exists() for m in methods)]
+                  if not all(scored(study, scene, m, seed, b) for m in methods)]
         step = CheckpointManager(workdir / "checkpoints").latest_step()
         keep = [s.with_suffix(x) for s in starts for x in (".msgpack", ".json") if s.with_suffix(".msgpack").exists()]
         if step is not None and not all(s.with_suffix(".msgpack").exists() for s in starts):
@@ -291,9 +314,27 @@ def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path
     config = with_workers(cooldown_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
                                           images=study.cooldown_images(budget), tiny=study.tiny), study.workers)
     model = run_dir(study.root, scene, method, lr, seed) / str(budget) / "model"
+    if (why := stale_cooldown(config, model.parent)) is not None:
+        shutil.rmtree(model.parent)
+        print(f"[study] {model.parent} {why}: made again", flush=True)
     if not model.with_suffix(".msgpack").exists():
         run(config, model.parent, export=model, progress=progress)
     score(study, scene, method, seed, budget, model, lr)
+
+
+def stale_cooldown(config: TrainConfig, workdir: pathlib.Path) -> str | None:
+    """Why the cool-down run in `workdir` is not `config`'s (another start, seed or data: its run record; or another
+    length: its model's steps), e.g. after --cooldown changed; None where it is (or there is none)."""
+    from lipjax import model_io
+    from lipjax.train.loop import check_same_run
+
+    try:
+        check_same_run(config, workdir)
+    except ValueError:
+        return "was started another way (its run.json)"
+    model = workdir / "model.msgpack"
+    steps = model_io.metadata(model.with_suffix("")).get("steps") if model.exists() else config.total_steps
+    return None if steps == config.total_steps else f"has {steps} steps, not the {config.total_steps} asked"
 
 
 def score(study: Study, scene: str, method: str, seed: int, images: int, model: pathlib.Path, lr: float) -> dict:
@@ -374,22 +415,92 @@ def missing(study: Study) -> list[str]:
         for seed in study.seeds[scene]:
             for method in study.methods:
                 left += [f"{scene} {method} seed {seed} at {b}" for b in study.budgets_for(scene, seed)
-                         if not result_path(study, scene, method, seed, b).exists()]
+                         if not scored(study, scene, method, seed, b)]
     return left
 
 
 def _done(study: Study, scene: str, trunk: str, seed: int, upto: int) -> bool:
     """Whether every score of the trunk and its branches up to `upto` images exists."""
     methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
-    return all(result_path(study, scene, m, seed, b).exists() for m in methods
+    return all(scored(study, scene, m, seed, b) for m in methods
                for b in study.budgets_for(scene, seed) if b <= upto)
+
+
+def images_left(study: Study, scene: str, trunk: str, seed: int, upto: int) -> dict[str, int]:
+    """The training images plan step (scene, trunk, seed, upto) still needs, by method: the trunk's tuning (rates
+    of TUNE_LRS not yet tried; its extensions cannot be foreseen) and its run on to the last export still needed,
+    and each cool-down whose model is not exported yet; runs part done count what their metrics.jsonl logged."""
+    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    left = dict.fromkeys(methods, 0)
+    lr = tuned_so_far(study, scene, trunk)
+    if lr is None:
+        tried = _tried(study, scene, trunk)
+        left[trunk] += study.tune_images * sum(f"{r:g}" not in tried for r in TUNE_LRS)
+    trunk_to = 0
+    for budget in [b for b in study.budgets_for(scene, seed) if b <= upto]:
+        todo = [m for m in methods if not scored(study, scene, m, seed, budget)]
+        start = budget - study.cooldown_images(budget)
+        if todo and (lr is None or not trunk_export(study.root, scene, trunk, lr, seed, start).with_suffix(
+                ".msgpack").exists()):
+            trunk_to = start
+        for method in todo:
+            cooldown = None if lr is None else run_dir(study.root, scene, method, lr, seed) / str(budget)
+            if cooldown is None or not (cooldown / "model.msgpack").exists():
+                left[method] += max(0, study.cooldown_images(budget) - _logged_images(cooldown))
+    if trunk_to:
+        left[trunk] += trunk_to - min(trunk_to, _logged_images(
+            None if lr is None else run_dir(study.root, scene, trunk, lr, seed)))
+    return left
+
+
+def _logged_images(workdir: pathlib.Path | None) -> int:
+    """The images a run in `workdir` has trained, as its metrics.jsonl logged them (0: no run there)."""
+    rows = _training_rows(workdir / "metrics.jsonl") if workdir is not None else []
+    return max((r["step"] for r in rows), default=0) * BATCH
+
+
+def _training_rows(path: pathlib.Path) -> list[dict]:
+    """The training lines (those with images_per_s) of a metrics.jsonl, oldest first; [] where there is none."""
+    if not path.is_file():
+        return []
+    return [r for r in map(json.loads, path.read_text().splitlines()) if "images_per_s" in r]
+
+
+def measured_rate(study: Study, scene: str, method: str) -> float | None:
+    """The images/s `method` trained at on `scene` in this --root: the newest rate its runs (any seed, tuning
+    included) logged; None where it has not run here."""
+    logs = [*(study.scene_dir(scene) / method).glob("**/metrics.jsonl"),
+            *(study.scene_dir(scene) / "tune" / method).glob("**/metrics.jsonl")]
+    logs.sort(key=lambda p: p.stat().st_mtime)
+    rates = [rows[-1]["images_per_s"] for rows in map(_training_rows, logs) if rows]
+    return rates[-1] if rates else None
+
+
+def plan_text(study: Study) -> str:
+    """--plan's text: each step of the plan, done or the images it still needs; the scores left; and the hours of
+    training left at the rates measured in this --root, one run at a time."""
+    lines, hours, unknown = [], 0.0, []
+    for scene, trunk, seed, upto in plan(study):
+        left = {m: n for m, n in images_left(study, scene, trunk, seed, upto).items() if n}
+        done = _done(study, scene, trunk, seed, upto)
+        lines.append(f"{scene} {trunk} seed {seed} up to {upto} images" + (
+            " (done)" if done else f" ({sum(left.values()):,} images to train)" if left else " (to score)"))
+        for method, n in left.items():
+            rate = measured_rate(study, scene, method)
+            hours += n / rate / 3600 if rate else 0.0
+            unknown += [] if rate or f"{scene} {method}" in unknown else [f"{scene} {method}"]
+    scores = missing(study)
+    lines.append(f"{len(scores)} scores left" + "".join(f"\n  {line}" for line in scores))
+    lines.append(f"{hours:.1f} h of training left at the rates measured in {study.root}, one run at a time" + (
+        f", and the runs of {', '.join(unknown)} (no rate measured there yet)" if unknown else ""))
+    return "\n".join(lines)
 
 
 def run_study(study: Study, progress: bool = True) -> None:
     for scene, trunk, seed, upto in plan(study):
         score_classical(study, scene)
         run_trunk(study, scene, trunk, seed, upto, progress)
-        write_report(study, missing(study))
+        write_report(study, missing(study), functools.partial(current, study))
 
 
 @contextlib.contextmanager
@@ -429,7 +540,8 @@ def main(argv=None) -> None:
     p.add_argument("--methods", help=f"comma-separated, of {','.join(METHODS)} (default: all)")
     p.add_argument("--limit", type=int, help="test frames (default: the tables', 100 rooms and 50 streets)")
     p.add_argument("--root", default=STUDY_ROOT, help="runs, checkpoints and models (default %(default)s)")
-    p.add_argument("--scores", default=SCORES, help=f"tuning and scores, committed (default {SCORES})")
+    p.add_argument("--scores", help=f"tuning and scores, committed (default {SCORES}; with --tiny, <root>/scores: a "
+                   "check never writes the committed scores)")
     p.add_argument("--results", help="where the report goes when the study ends or with --report (default "
                    "docs/results; with --tiny, <root>/report: a check never writes the committed results)")
     p.add_argument("--workers", type=int, default=1, help="loader processes per run (default 1; 14 on a 16-core "
@@ -446,8 +558,11 @@ def main(argv=None) -> None:
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         p.error(f"unknown method(s) {unknown}; choose of {','.join(METHODS)}")
+    scores = pathlib.Path(args.scores or (pathlib.Path(args.root) / "scores" if args.tiny else SCORES))
+    if args.tiny and scores.resolve() == pathlib.Path(SCORES).resolve():
+        p.error(f"--tiny scores are checks: give --scores another folder than the study's {SCORES}")
     try:
-        study = Study(pathlib.Path(args.root), pathlib.Path(args.scores), scenes,
+        study = Study(pathlib.Path(args.root), scores, scenes,
                       {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
                       args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
                       args.tune_images, args.cooldown, args.limit, args.tiny, methods, args.workers,
@@ -455,10 +570,7 @@ def main(argv=None) -> None:
     except ValueError as exc:
         p.error(str(exc))
     if args.plan:
-        left = missing(study)
-        print("\n".join(f"{s} {t} seed {k} up to {n} images" + (" (done)" if _done(study, s, t, k, n) else "")
-                        for s, t, k, n in plan(study)))
-        print(f"{len(left)} scores left" + "".join(f"\n  {line}" for line in left))
+        print(plan_text(study))
         return
     if args.save_in_progress:
         if study.warm_starts is None:
@@ -470,8 +582,8 @@ def main(argv=None) -> None:
     enable_compilation_cache()
     if not args.report:
         run_study(study, progress=not args.no_progress)
-    write_report(study, missing(study), pathlib.Path(args.results or (study.root / "report" if args.tiny
-                                                                      else "docs/results")))
+    out = args.results or (study.root / "report" if args.tiny else "docs/results")
+    write_report(study, missing(study), functools.partial(current, study), pathlib.Path(out))
 
 
 if __name__ == "__main__":

@@ -74,18 +74,26 @@ def paired_test(scores: list[dict], a: str, b: str, images: int) -> dict | None:
     if not seeds:
         return None
 
+    runs = [r for r in runs_a + runs_b if r["seed"] in seeds]
+    frames = [p["id"] for p in runs[0]["per_image"]]
+    for r in runs:
+        if [p["id"] for p in r["per_image"]] != frames:
+            raise ValueError(f"{r['method']} seed {r['seed']} at {images} images was scored on other test frames than "
+                             f"{runs[0]['method']} seed {runs[0]['seed']}: score both with the same --limit")
+    if len(frames) < 2:
+        return None
+
     def per_seed_frame(runs):  # [seed, frame] RMSE m
         return np.array([[p["rmse_m"] for p in r["per_image"]] for r in runs if r["seed"] in seeds])
 
     rmse_a, rmse_b = per_seed_frame(runs_a), per_seed_frame(runs_b)
-    if rmse_a.shape != rmse_b.shape or rmse_a.shape[1] < 2:
-        return None
     x, y = rmse_a.mean(axis=0), rmse_b.mean(axis=0)
     diff = x - y
     test = {"a": a, "b": b, "images": images, "seeds": seeds, "frames": int(len(x)),
             "mean_rmse_a_m": float(x.mean()), "mean_rmse_b_m": float(y.mean()),
             "a_better_frames": int((diff < 0).sum()), "b_better_frames": int((diff > 0).sum()),
             "a_better_seeds": int((rmse_a.mean(axis=1) < rmse_b.mean(axis=1)).sum()),
+            "b_better_seeds": int((rmse_a.mean(axis=1) > rmse_b.mean(axis=1)).sum()),
             "diff_interval_m": list(bootstrap_interval(rmse_a - rmse_b)),
             "wilcoxon_p": float(stats.wilcoxon(x, y).pvalue) if np.any(diff) else 1.0,
             "ttest_p": float(stats.ttest_rel(x, y).pvalue) if np.any(diff) else 1.0}
@@ -95,18 +103,25 @@ def paired_test(scores: list[dict], a: str, b: str, images: int) -> dict | None:
 
 def verdict(test: dict) -> str:
     """The rule fixed in decision 0028: a method leads where the 95 % interval of mean RMSE a - b excludes 0 and it
-    is better on every seed; otherwise the study does not separate the two."""
+    is better (strictly) on every seed; otherwise the study does not separate the two."""
     low, high = test["diff_interval_m"]
     if high < 0 and test["a_better_seeds"] == len(test["seeds"]):
         return f"{test['a']} leads"
-    if low > 0 and test["a_better_seeds"] == 0:
+    if low > 0 and test["b_better_seeds"] == len(test["seeds"]):
         return f"{test['b']} leads"
     return "not separated"
 
 
 def best_end_to_end(summary: dict) -> str | None:
+    """The end-to-end network of lowest mean RMSE over the seeds they all have (each one's own where they share
+    none)."""
     present = [m for m in END_TO_END if m in summary]
-    return min(present, key=lambda m: statistics.mean(summary[m]["rmse_m"])) if present else None
+    common = set.intersection(*(set(summary[m]["seeds"]) for m in present)) if present else set()
+
+    def mean_rmse(m):
+        return statistics.mean(r for k, r in zip(summary[m]["seeds"], summary[m]["rmse_m"])
+                               if not common or k in common)
+    return min(present, key=mean_rmse) if present else None
 
 
 def curve(scores: list[dict]) -> dict:
@@ -296,15 +311,16 @@ def plot_iterations(path: pathlib.Path, per_k: dict, title: str, linear_rmse_m: 
     fig.savefig(path)
 
 
-def write_report(study, scores_left: list[str], out: pathlib.Path | None = None) -> dict:
+def write_report(study, scores_left: list[str], keep, out: pathlib.Path | None = None) -> dict:
     """Writes the report of `study` (an experiments.equal_budget.Study, whose `scores_left` are still to run) into
-    `out` (default: <root>/report)."""
+    `out` (default: <root>/report), from the scores `keep(score)` admits (equal_budget.current: those made at the
+    tuned rate and the study's cool-down)."""
     out = pathlib.Path(out) if out is not None else study.root / "report"
     out.mkdir(parents=True, exist_ok=True)
     doc: dict = {"details": {"scores_left": scores_left, "cooldown": study.cooldown}}
     for scene in SCENES:
-        # a score made another way (before the cool-down; the study remakes it when it gets there) is left out
-        scores = [s for s in load_scores(study.scores, scene) if s.get("cooldown") == study.cooldown]
+        # a score made another way (another rate or cool-down; the study remakes it when it gets there) is left out
+        scores = [s for s in load_scores(study.scores, scene) if keep(s)]
         classical_path = study.scores_dir(scene) / "classical.json"
         classical = json.loads(classical_path.read_text()) if classical_path.exists() else {}
         if not scores:

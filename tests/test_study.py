@@ -27,6 +27,16 @@ def study(tmp_path, **kw):
     return equal_budget.Study(tmp_path, tmp_path / "scores", **{**defaults, **kw})
 
 
+def tuned(images):
+    """A trunk's tuning.json entry: 5e-4 best of TUNE_LRS, each tried after `images` images."""
+    return {f"{lr:g}": {"val_rmse_m": v, "images": images} for lr, v in zip(equal_budget.TUNE_LRS, (0.6, 0.5, 0.7))}
+
+
+def made(s, method, lr, **kw):
+    """A score of `method` as study `s` makes it at rate `lr` (kw: made another way)."""
+    return {"method": method, "scene": "indoor", "learning_rate": lr, "cooldown": s.cooldown, **kw}
+
+
 def test_budgets_every_seed_at_b_seed_0_along_the_whole_curve(tmp_path):
     s = study(tmp_path)
     assert s.budgets_for("indoor", 1) == [32, 64]
@@ -67,7 +77,8 @@ def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_
     from lipjax.train.checkpoint import CheckpointManager
 
     s = study(tmp_path / "a", warm_starts=tmp_path / "warm", methods=("unet",))
-    tuning = {"unet": {"0.0002": {"val_rmse_m": 0.6}, "0.0005": {"val_rmse_m": 0.5}, "0.00125": {"val_rmse_m": 0.7}}}
+    tuning = {"unet": {"0.0002": {"val_rmse_m": 0.6, "images": 16}, "0.0005": {"val_rmse_m": 0.5, "images": 16},
+                       "0.00125": {"val_rmse_m": 0.7, "images": 16}}}
     (s.scores / "indoor").mkdir(parents=True)
     (s.scores / "indoor" / "tuning.json").write_text(json.dumps(tuning))
     runs = {k: equal_budget.run_dir(s.root, "indoor", "unet", 5e-4, k) for k in (0, 1)}
@@ -82,7 +93,7 @@ def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_
     (runs[1] / "models" / "32.msgpack").unlink()  # seed 1 has not reached the start of budget 64's cool-down
     for k, budgets in ((0, (32, 64, 96)), (1, (32,))):  # seed 0 finished; seed 1 scored at 32, not at 64
         for b in budgets:
-            equal_budget._write_json(equal_budget.result_path(s, "indoor", "unet", k, b), {})
+            equal_budget._write_json(equal_budget.result_path(s, "indoor", "unet", k, b), made(s, "unet", 5e-4))
     stale = equal_budget.run_dir(s.warm_starts, "indoor", "unet", 5e-4, 0)
     (stale / "checkpoints").mkdir(parents=True)  # kept by an earlier session, finished since
 
@@ -98,6 +109,83 @@ def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_
     (runs[1] / "models" / "32.msgpack").write_text("32")
     equal_budget.save_in_progress(s)
     assert sorted(p.name for p in kept[0].rglob("*")) == ["32.json", "32.msgpack", "models", "run.json"]
+
+
+def test_plan_counts_the_images_left_and_the_hours_at_the_rates_measured(tmp_path):
+    import os
+
+    s = study(tmp_path, seeds={"indoor": (1,)}, curve={"indoor": (32, 64)}, methods=("lip-cnn", "lip-ad"))
+    # untuned: three rates of 16 images, the trunk on to 64 - 32, cool-downs of 16 (budget 32) and 32 (budget 64)
+    assert equal_budget.images_left(s, "indoor", "lip-cnn", 1, 64) == {"lip-cnn": 48 + 32 + 16 + 32, "lip-ad": 48}
+    (s.scores / "indoor").mkdir(parents=True)
+    (s.scores / "indoor" / "tuning.json").write_text(json.dumps({"lip-cnn": tuned(16)}))
+    for m in ("lip-cnn", "lip-ad"):
+        equal_budget._write_json(equal_budget.result_path(s, "indoor", m, 1, 32), made(s, m, 5e-4))
+    trunk = equal_budget.run_dir(s.root, "indoor", "lip-cnn", 5e-4, 1)
+    for workdir, step, rate in ((trunk, 2, 0.02), (trunk / "64", 1, 0.01)):
+        workdir.mkdir(parents=True)
+        (workdir / "metrics.jsonl").write_text(json.dumps({"step": step, "images_per_s": rate}) + "\n" +
+                                               json.dumps({"step": step, "split": "val", "rmse_m": 1.0}) + "\n")
+    os.utime(trunk / "metrics.jsonl", (1, 1))  # the cool-down's log is the newest: its rate counts
+    # the trunk has logged 2 steps (16 images) of the 32, lip-cnn's cool-down 1 step (8) of its 32; lip-ad none
+    assert equal_budget.images_left(s, "indoor", "lip-cnn", 1, 64) == {"lip-cnn": 16 + 24, "lip-ad": 32}
+    assert equal_budget.measured_rate(s, "indoor", "lip-cnn") == 0.01
+    assert equal_budget.measured_rate(s, "indoor", "lip-ad") is None
+    text = equal_budget.plan_text(s)
+    assert "indoor lip-cnn seed 1 up to 64 images (72 images to train)" in text and "2 scores left" in text
+    assert text.endswith(f"{40 / 0.01 / 3600:.1f} h of training left at the rates measured in {s.root}, one run at a "
+                         "time, and the runs of indoor lip-ad (no rate measured there yet)")
+    # the export at 32 and lip-cnn's cool-down model made: only lip-ad's cool-down is left to train
+    for path in (trunk / "models" / "32.msgpack", trunk / "64" / "model.msgpack"):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("")
+    assert equal_budget.images_left(s, "indoor", "lip-cnn", 1, 64) == {"lip-cnn": 0, "lip-ad": 32}
+
+
+def test_a_score_counts_where_made_at_the_tuned_rate_after_the_studys_tuning_images_and_cool_down(tmp_path):
+    s = study(tmp_path, methods=("lip-cnn", "lip-ad"))
+    (s.scores / "indoor").mkdir(parents=True)
+    (s.scores / "indoor" / "tuning.json").write_text(json.dumps({"lip-cnn": tuned(3000)}))
+    assert equal_budget.tuned_so_far(s, "indoor", "lip-cnn") is None  # tried after 3,000 images, not the study's 16
+    (s.scores / "indoor" / "tuning.json").write_text(json.dumps({"lip-cnn": tuned(16)}))
+    assert equal_budget.tuned_so_far(s, "indoor", "lip-cnn") == 5e-4
+    for doc, counts in ((made(s, "lip-ad", 5e-4), True), (made(s, "lip-ad", 2e-4), False),
+                        (made(s, "lip-ad", 5e-4, cooldown=0.2), False)):
+        equal_budget._write_json(equal_budget.result_path(s, "indoor", "lip-ad", 0, 32), doc)
+        assert equal_budget.current(s, doc) is counts and equal_budget.scored(s, "indoor", "lip-ad", 0, 32) is counts
+        assert ("indoor lip-ad seed 0 at 32" in equal_budget.missing(s)) is not counts
+    assert not equal_budget.scored(s, "indoor", "lip-cnn", 0, 32)  # no file
+
+
+def test_a_cool_down_made_another_way_is_made_again(tmp_path):
+    from lipjax.train.loop import RUN_FILE, run_record
+
+    def cooldown(start, images):
+        return cooldown_config("lip-cnn", "indoor", learning_rate=5e-4, seed=0, init_from=start, images=images,
+                               tiny=True)
+
+    config, workdir = cooldown("models/24", 16), tmp_path / "32"
+    assert equal_budget.stale_cooldown(config, workdir) is None  # nothing there yet
+    workdir.mkdir()
+    (workdir / RUN_FILE).write_text(json.dumps(run_record(cooldown("models/16", 16))))  # from another start
+    assert "started another way" in equal_budget.stale_cooldown(config, workdir)
+    (workdir / RUN_FILE).write_text(json.dumps(run_record(config)))
+    assert equal_budget.stale_cooldown(config, workdir) is None  # the same run, part done
+    model_io.save(workdir / "model", config.model, {}, {"steps": 4})  # a model of 4 steps: a cool-down of 32 images
+    assert equal_budget.stale_cooldown(config, workdir) == "has 4 steps, not the 2 asked"
+    assert equal_budget.stale_cooldown(cooldown("models/24", 32), workdir) is None  # the 32-image cool-down it is
+    model_io.save(workdir / "model", config.model, {}, {"steps": 2})
+    assert equal_budget.stale_cooldown(config, workdir) is None
+
+
+def test_tiny_checks_keep_their_scores_in_their_root_never_in_the_committed_ones(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit):
+        equal_budget.main(["--tiny", "--plan", "--scores", equal_budget.SCORES])
+    seen = {}
+    monkeypatch.setattr(equal_budget, "plan_text", lambda s: seen.setdefault("scores", s.scores) and "")
+    equal_budget.main(["--tiny", "--plan", "--root", "check"])
+    assert seen["scores"] == pathlib.Path("check") / "scores"
 
 
 def test_a_tiny_check_reports_into_its_root_never_into_the_committed_results(tmp_path, monkeypatch):
@@ -195,7 +283,8 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
 
     def runs(method, offset):
         return [{"method": method, "images": 32, "seed": k,
-                 "per_image": [{"rmse_m": float(v)} for v in rng.uniform(0.2, 0.4, frames) + offset]}
+                 "per_image": [{"id": f"f{i}", "rmse_m": float(v)}
+                               for i, v in enumerate(rng.uniform(0.2, 0.4, frames) + offset)]}
                 for k in (0, 1)]
 
     a, b = runs("lip-ad", 0.0), runs("unet", 0.05)
@@ -209,6 +298,9 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
     assert low < float(np.mean(x - y)) < high < 0 and got["a_better_seeds"] == 2  # b is 0.05 m worse throughout
     assert got["verdict"] == "lip-ad leads"
     assert study_report.paired_test(a, "lip-ad", "unet", 32) is None  # no run of b: no test
+    b[1]["per_image"] = b[1]["per_image"][1:] + b[1]["per_image"][:1]  # the same frames in another order
+    with pytest.raises(ValueError, match="unet seed 1 at 32 images was scored on other test frames than lip-ad"):
+        study_report.paired_test(a + b, "lip-ad", "unet", 32)
 
 
 def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
@@ -225,16 +317,25 @@ def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
 
 
 def test_the_verdict_is_decision_0028s_rule_interval_excluding_zero_and_every_seed():
-    def verdict(low, high, better_seeds, seeds=3):
+    def verdict(low, high, a_better, b_better=None, seeds=3):
         return study_report.verdict({"a": "lip-ad", "b": "cspn", "diff_interval_m": [low, high],
-                                     "a_better_seeds": better_seeds, "seeds": list(range(seeds))})
+                                     "a_better_seeds": a_better, "seeds": list(range(seeds)),
+                                     "b_better_seeds": seeds - a_better if b_better is None else b_better})
 
     assert verdict(-0.010, -0.001, 3) == "lip-ad leads"
     assert verdict(0.001, 0.010, 0) == "cspn leads"
     assert verdict(-0.010, -0.001, 2) == "not separated"  # the interval excludes 0 but one seed goes the other way
     assert verdict(0.001, 0.010, 1) == "not separated"
+    assert verdict(0.001, 0.010, 0, b_better=2) == "not separated"  # a seed on which the two tie: not better there
     assert verdict(-0.013, 0.001, 3) == "not separated"  # better on every seed, but the interval holds 0
     assert verdict(0.0, 0.010, 0) == "not separated"  # 0 itself is not excluded
+
+
+def test_the_best_end_to_end_network_is_ranked_over_the_seeds_they_all_have():
+    summary = {"cspn": {"seeds": [0, 1], "rmse_m": [0.21, 0.21]},
+               "unet": {"seeds": [0, 1, 2], "rmse_m": [0.205, 0.205, 0.30]}}  # its seed 2 not yet run by CSPN
+    assert study_report.best_end_to_end(summary) == "unet"
+    assert study_report.best_end_to_end({"lip-cnn": {"seeds": [0], "rmse_m": [0.1]}}) is None
 
 
 def test_bootstrap_interval_spans_the_seeds_and_the_frames_it_draws_from():
