@@ -3,7 +3,7 @@
     python -m experiments.train --config lip_cnn_indoor [--workdir runs/lip_cnn_indoor] [--set g_steps=200]
     python -m experiments.train --config lip_cnn_nyu --set data.root=/data/nyudepthv2 --export runs/lip_cnn_nyu/model
     python -m experiments.train --config lip_cnn_indoor --export-only --export PATH   # the latest checkpoint
-    python -m experiments.train --config lip_cnn_indoor --export-only --average 4 --export PATH  # mean of 4
+    python -m experiments.train --config lip_cnn_indoor --export-only --average 2 --export PATH  # mean of 2
     python -m experiments.train --config lip_any --soup OLDER,NEWER --export PATH  # mean of models of one chain
 
 A killed run resumes from its last checkpoint when started again with the same workdir. The run writes only into

@@ -254,7 +254,8 @@ def _add_train_parser(sub) -> None:
                    "complete --model OUT)")
     t.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", help="model to start from: shipped name or saved path (default: the default model)")
-    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {TRAINING.steps})")
+    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {TRAINING.steps}; "
+                   f"{TRAINING.adapt_steps} with --self-supervised)")
     t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {TRAINING.batch_size})")
     t.add_argument("--sampler", help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps")

@@ -22,8 +22,9 @@ DEFAULT_COLUMNS = ("rmse_m", "mae_m", "rel", "delta1_pct", "delta2_pct", "delta3
                    "ms_per_frame")  # lipjax.evaluate.DEFAULT_COLUMNS
 CLASSICAL = ("nearest", "linear", "ip_basic", "ip_basic_multiscale", "ip_basic_adaptive", "colorization",
              "lip-wavelet")  # tuple(lipjax.methods.CLASSICAL)
-# `lipjax train`'s defaults: lipjax.train.folder's FOLDER_STEPS, FOLDER_BATCH_SIZE, FOLDER_DATA.crop, .num_workers
-TRAINING = types.SimpleNamespace(steps=2000, batch_size=8, crop=(128, 160), workers=2)
+# `lipjax train`'s defaults: lipjax.train.folder's FOLDER_STEPS, FOLDER_BATCH_SIZE, FOLDER_DATA.crop, .num_workers;
+# with --self-supervised, lipjax.train.adapt's ADAPT_STEPS
+TRAINING = types.SimpleNamespace(steps=2000, batch_size=8, crop=(128, 160), workers=2, adapt_steps=500)
 
 COMPLETE_HELP = """\
 Completes the sparse depth of your own frames.

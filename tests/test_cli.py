@@ -587,7 +587,7 @@ def test_the_help_values_are_the_librarys():
     """lipjax.cli_help copies values of the library so that the help loads no JAX: each copy equals its source."""
     from lipjax import cli_help, evaluate, methods
     from lipjax.data import folder, protocols, sources, synthetic
-    from lipjax.train import folder as train_folder
+    from lipjax.train import adapt, folder as train_folder
 
     assert cli_help.OUT_FORMATS == folder.OUT_FORMATS
     assert (cli_help.SOURCES, cli_help.NO_PROTOCOL) == (sources.SOURCES, sources.NO_PROTOCOL)
@@ -598,6 +598,7 @@ def test_the_help_values_are_the_librarys():
     training = cli_help.TRAINING
     assert (training.steps, training.batch_size) == (train_folder.FOLDER_STEPS, train_folder.FOLDER_BATCH_SIZE)
     assert (training.crop, training.workers) == (train_folder.FOLDER_DATA.crop, train_folder.FOLDER_DATA.num_workers)
+    assert training.adapt_steps == adapt.ADAPT_STEPS
     assert cli.build_parser().parse_args(["complete", "--rgb", "a", "--out", "b", "--depth-scale", "nyu"]
                                          ).depth_scale == folder.parse_depth_scale("nyu")
 

@@ -89,7 +89,8 @@ def adapt_folder(root: str | os.PathLike, out: str | os.PathLike, *, init: str |
     given = [k for k in ("train_sampler", "val_sampler") if k in data]
     if given:
         raise ValueError(f"{'/'.join(given)}={data[given[0]]!r}: a self-supervised run's input is the folder's own "
-                         "sparse/ maps less the share hidden (hide=F, --hide F); drop the sampler (--sampler)")
+                         "sparse/ maps less the share hidden (hide=F, --self-supervised F); drop the sampler "
+                         "(--sampler)")
     name = pathlib.Path(out).name
     config = adapt_config(model_io.load(init)[0], init, name=name, hide=hide, steps=steps or ADAPT_STEPS,
                           batch_size=batch_size or ADAPT_BATCH_SIZE, **data)
