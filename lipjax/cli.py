@@ -25,7 +25,7 @@ import sys
 
 from lipjax import __version__, console
 from lipjax.cli_help import (CLASSICAL, COMPLETE_HELP, DEFAULT_COLUMNS, NO_PROTOCOL, OUT_FORMATS, PROTOCOLS, SOURCES,
-                             SPLITS, SYNTHETIC_KINDS, TRAINING, depth_scale)
+                             SPLITS, SYNTHETIC_KINDS, TRAIN_STEPS_HELP, TRAINING, depth_scale)
 
 PROG = "lipjax"
 _RAW, _BOOL = argparse.RawDescriptionHelpFormatter, argparse.BooleanOptionalAction
@@ -254,8 +254,7 @@ def _add_train_parser(sub) -> None:
                    "complete --model OUT)")
     t.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", help="model to start from: shipped name or saved path (default: the default model)")
-    t.add_argument("--steps", type=console.positive_int, help=f"training steps (default {TRAINING.steps}; "
-                   f"{TRAINING.adapt_steps} with --self-supervised)")
+    t.add_argument("--steps", type=console.positive_int, help=TRAIN_STEPS_HELP)
     t.add_argument("--batch-size", type=console.positive_int, help=f"frames per step (default {TRAINING.batch_size})")
     t.add_argument("--sampler", help="sparse input spec (default: 200 / 500 uniform and 200 Bernoulli "
                    "points), or input[:N] for your sparse/ maps")

@@ -25,6 +25,7 @@ CLASSICAL = ("nearest", "linear", "ip_basic", "ip_basic_multiscale", "ip_basic_a
 # `lipjax train`'s defaults: lipjax.train.folder's FOLDER_STEPS, FOLDER_BATCH_SIZE, FOLDER_DATA.crop, .num_workers;
 # with --self-supervised, lipjax.train.adapt's ADAPT_STEPS
 TRAINING = types.SimpleNamespace(steps=2000, batch_size=8, crop=(128, 160), workers=2, adapt_steps=500)
+TRAIN_STEPS_HELP = f"training steps (default {TRAINING.steps}; {TRAINING.adapt_steps} with --self-supervised)"
 
 COMPLETE_HELP = """\
 Completes the sparse depth of your own frames.
