@@ -181,6 +181,9 @@ def test_one_frame_adapts_on_itself(tmp_path):
     completer = adapt_frame(rgb, sparse, model=str(init), steps=2)
     assert completer.metadata["steps"] == 2 and completer.metadata["train_sampler"] == "hide:0.2"
     assert completer(rgb, sparse).shape == SIZE
+    start = jax.tree_util.tree_leaves(model_io.load(init)[1])  # it trained: weights moved from the start's
+    assert not all(np.array_equal(a, b) for a, b in zip(jax.tree_util.tree_leaves(completer.params), start,
+                                                        strict=True))
 
 
 @pytest.mark.parametrize("argv, message", [

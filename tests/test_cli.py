@@ -436,7 +436,6 @@ def test_evaluate_prints_a_markdown_table(model, tmp_path, capsys):
 
 
 def test_export_command_writes_a_deserializable_file(model, tmp_path):
-    pytest.importorskip("flatbuffers")
     out = tmp_path / "m.stablehlo"
     rc = cli.main(["export", "--model", model[0], "--height", "8", "--width", "16", "--batch", "2", "--out", str(out),
                    "--quiet"])

@@ -13,9 +13,6 @@ from lipjax.priors.network import network_preset
 
 from helpers import perturbed
 
-# jax.export serialisation needs flatbuffers, an optional jax dependency (to be listed in pyproject).
-pytest.importorskip("flatbuffers")
-
 B, H, W = 2, 24, 32
 
 

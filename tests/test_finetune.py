@@ -116,6 +116,8 @@ def test_fine_tuning_a_folder_of_mixed_sizes_on_its_own_input_gives_a_model_that
 
     model = lipjax.load_model(out)
     assert model.scan_lines_trained
+    trained, start = (jax.tree_util.tree_leaves(model_io.load(path)[1]) for path in (out, init))
+    assert not all(np.array_equal(a, b) for a, b in zip(trained, start, strict=True))  # it trained: weights moved
     rgb, _, sparse = _frame(7, SIZES[1])
     depth = model(rgb, sparse)
     assert depth.shape == SIZES[1] and np.all(np.isfinite(depth))

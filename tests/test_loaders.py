@@ -1,7 +1,7 @@
 """Loaders read tiny fixture files written here in each real on-disk format (never the shared data)."""
 from __future__ import annotations
 
-import importlib.util
+import sys
 
 import cv2
 import h5py
@@ -123,9 +123,8 @@ def test_nyu_h5_errors(tmp_path):
         NyuH5Dataset(tmp_path, "val")
 
 
-@pytest.mark.skipif(importlib.util.find_spec("tensorflow_datasets") is not None,
-                    reason="tensorflow_datasets installed")
-def test_nyu_tfds_missing_package_error():
+def test_nyu_tfds_missing_package_error(monkeypatch):
+    monkeypatch.setitem(sys.modules, "tensorflow_datasets", None)  # installed or not: the import fails
     with pytest.raises(DatasetError, match=r"pip install lipjax\[tfds\]"):
         NyuTfdsDataset("val")
 

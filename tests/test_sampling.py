@@ -196,11 +196,12 @@ def test_noise_outliers_exact_fraction_and_positive():
     assert np.array_equal(huge > 0, clean > 0) and huge[clean > 0].min() >= 1e-3
 
 
-def test_noisy_wrapper():
+def test_noisy_wrapper_is_its_noise_applied_to_its_samplers_samples():
     frame = random_frame()
     s = Noisy(UniformSampler(50), Noise(std_m=0.2))
-    out = s(frame, seed=4)
-    assert np.array_equal(out > 0, UniformSampler(50)(frame, seed=4) > 0) and np.array_equal(out, s(frame, seed=4))
+    out, clean = s(frame, seed=4), UniformSampler(50)(frame, seed=4)
+    assert np.array_equal(out, Noise(std_m=0.2)(clean, frame, 4))  # the same seed for both stages
+    assert np.array_equal(out > 0, clean > 0) and not np.array_equal(out, clean)
 
 
 # ---- spec parser -----------------------------------------------------------------------------------------------
