@@ -49,9 +49,9 @@ import shutil
 import sys
 
 
-from experiments.configs.study import (BRANCHES, COOLDOWN_FRACTION, METHODS, SCENES, STUDY_ROOT, TRUNKS,
+from experiments.configs.study import (COOLDOWN_FRACTION, METHODS, SCENES, STUDY_ROOT, TRUNKS, branches_of,
                                       cooldown_config, cooldown_images, run_dir, test_split, trunk_config,
-                                      trunk_export)
+                                      trunk_export, trunk_of)
 from experiments.study_report import best_rate, write_report
 from lipjax.train.config import TrainConfig
 from lipjax.console import ArgumentParser, run_main
@@ -207,9 +207,8 @@ def scored(study: Study, scene: str, method: str, seed: int, images: int) -> boo
 def current(study: Study, doc: dict) -> bool:
     """Whether score `doc` was made the study's way: at its trunk's tuned learning rate (tuning complete) and with
     the study's cool-down share. The others are left out of the report and made again (`drop_stale_scores`)."""
-    trunk = BRANCHES.get(doc.get("method"), (doc.get("method"),))[0]
     made = (doc.get("learning_rate"), doc.get("cooldown"))
-    return made == (tuned_so_far(study, doc.get("scene"), trunk), study.cooldown)
+    return made == (tuned_so_far(study, doc.get("scene"), trunk_of(doc.get("method"))), study.cooldown)
 
 
 def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progress: bool) -> None:
@@ -219,7 +218,7 @@ def run_trunk(study: Study, scene: str, trunk: str, seed: int, upto: int, progre
 
     lr = tuned_learning_rate(study, scene, trunk, progress)
     budgets = [b for b in study.budgets_for(scene, seed) if b <= upto]
-    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    methods = branches_of(trunk, study.methods)
     drop_stale_scores(study, scene, methods, seed, lr)
     final = max(study.budgets_for(scene, seed))  # the run's length is fixed by its seed's largest budget
     config = with_workers(trunk_config(trunk, scene, learning_rate=lr, seed=seed, steps=final // BATCH,
@@ -280,7 +279,7 @@ def save_in_progress(study: Study) -> list[pathlib.Path]:
         if lr is None or not (workdir := run_dir(study.root, scene, trunk, lr, seed)).is_dir():
             continue
         dest = run_dir(study.warm_starts, scene, trunk, lr, seed)
-        methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+        methods = branches_of(trunk, study.methods)
         starts = [trunk_export(study.root, scene, trunk, lr, seed, b - study.cooldown_images(b))
                   for b in study.budgets_for(scene, seed)
                   if not all(scored(study, scene, m, seed, b) for m in methods)]
@@ -400,8 +399,7 @@ def score_classical(study: Study, scene: str) -> dict:
 def plan(study: Study) -> list[tuple[str, str, int, int]]:
     """(scene, trunk, seed, up to images) in the order they run: every seed at `images` on each scene in turn, then
     seed 0 on along the curve."""
-    trunks = [t for t in TRUNKS if t in study.methods or any(
-        BRANCHES[m][0] == t for m in study.methods if m in BRANCHES)]
+    trunks = [t for t in TRUNKS if any(trunk_of(m) == t for m in study.methods)]
     steps = [(scene, t, seed, study.images) for scene in study.scenes for seed in study.seeds[scene] for t in trunks]
     steps += [(scene, t, seed, max(study.budgets_for(scene, seed))) for scene in study.scenes
               for seed in study.seeds[scene] for t in trunks if max(study.budgets_for(scene, seed)) > study.images]
@@ -421,7 +419,7 @@ def missing(study: Study) -> list[str]:
 
 def _done(study: Study, scene: str, trunk: str, seed: int, upto: int) -> bool:
     """Whether every score of the trunk and its branches up to `upto` images exists."""
-    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    methods = branches_of(trunk, study.methods)
     return all(scored(study, scene, m, seed, b) for m in methods
                for b in study.budgets_for(scene, seed) if b <= upto)
 
@@ -430,7 +428,7 @@ def images_left(study: Study, scene: str, trunk: str, seed: int, upto: int) -> d
     """The training images plan step (scene, trunk, seed, upto) still needs, by method: the trunk's tuning (rates
     of TUNE_LRS not yet tried; its extensions cannot be foreseen) and its run on to the last export still needed,
     and each cool-down whose model is not exported yet; runs part done count what their metrics.jsonl logged."""
-    methods = [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in study.methods]
+    methods = branches_of(trunk, study.methods)
     left = dict.fromkeys(methods, 0)
     lr = tuned_so_far(study, scene, trunk)
     if lr is None:
@@ -479,14 +477,16 @@ def measured_rate(study: Study, scene: str, method: str) -> float | None:
 def plan_text(study: Study) -> str:
     """--plan's text: each step of the plan, done or the images it still needs; the scores left; and the hours of
     training left at the rates measured in this --root, one run at a time."""
-    lines, hours, unknown = [], 0.0, []
+    lines, hours, unknown, rates = [], 0.0, [], {}
     for scene, trunk, seed, upto in plan(study):
         left = {m: n for m, n in images_left(study, scene, trunk, seed, upto).items() if n}
         done = _done(study, scene, trunk, seed, upto)
         lines.append(f"{scene} {trunk} seed {seed} up to {upto} images" + (
             " (done)" if done else f" ({sum(left.values()):,} images to train)" if left else " (to score)"))
         for method, n in left.items():
-            rate = measured_rate(study, scene, method)
+            if (scene, method) not in rates:  # one read of its logs for all its steps
+                rates[scene, method] = measured_rate(study, scene, method)
+            rate = rates[scene, method]
             hours += n / rate / 3600 if rate else 0.0
             unknown += [] if rate or f"{scene} {method}" in unknown else [f"{scene} {method}"]
     scores = missing(study)

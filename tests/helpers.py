@@ -41,3 +41,15 @@ def children(pid: int) -> set[int]:
         if int(fields[1]) == pid and fields[0] != "Z":
             kids.add(int(stat.parent.name))
     return kids
+
+
+# Parameter counts by hand (tests/test_network.py, tests/test_networks.py); a GroupNorm of c channels has 2c.
+def conv_params(k: int, a: int, b: int, bias: bool = True) -> int:
+    """A k x k convolution from a to b channels: k*k*a*b weights, and b biases."""
+    return k * k * a * b + (b if bias else 0)
+
+
+def up_projection_params(a: int, f: int) -> int:
+    """lipjax.priors.network.UpProjection from a to f channels: two sub-pixel up-convolutions (3x3 to 4f channels)
+    and a 3x3 convolution, each GroupNorm-ed."""
+    return 2 * (conv_params(3, a, 4 * f) + 2 * f) + conv_params(3, f, f) + 2 * f

@@ -7,6 +7,8 @@ import pytest
 from lipjax import model as lip_model
 from lipjax.priors.network import PRESETS, network_preset
 
+from helpers import conv_params as conv, up_projection_params as up_projection
+
 # Per-iteration parameter counts of the presets (the paper: 7.88 M over its iterations, Table II), as
 # `counted_by_hand` derives them from the architecture.
 EXPECTED_PER_ITERATION = {"small": 493_721, "paper": 2_559_377, "tiny": 41_025}
@@ -15,14 +17,8 @@ EXPECTED_PER_ITERATION = {"small": 493_721, "paper": 2_559_377, "tiny": 41_025}
 def counted_by_hand(prior) -> int:
     """ProxNet's parameters from its widths: a k x k conv from a to b channels has k*k*a*b weights and b biases, a
     GroupNorm of c channels 2c; the input is depth + RGB (4 channels)."""
-    def conv(k, a, b):
-        return k * k * a * b + b
-
     def bottleneck(a, w):  # 1x1 projection shortcut; 1x1 -> 3x3 -> 1x1 (expansion 4), each normalised
         return conv(1, a, 4 * w) + conv(1, a, w) + 2 * w + conv(3, w, w) + 2 * w + conv(1, w, 4 * w) + 8 * w
-
-    def up_projection(a, f):  # two sub-pixel up-convolutions (3x3 to 4f channels), a 3x3 conv, each normalised
-        return 2 * (conv(3, a, 4 * f) + 2 * f) + conv(3, f, f) + 2 * f
 
     s, (w1, w2, w3), (f1, f2, f3) = prior.stem_width, prior.bottleneck_widths, prior.up_widths
     return (conv(3, 4, s) + 2 * s + bottleneck(s, w1) + bottleneck(4 * w1, w2) + bottleneck(4 * w2, w3)

@@ -27,6 +27,8 @@ from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.state import init_state
 from lipjax.train.steps import make_steps
 
+from helpers import conv_params, up_projection_params
+
 EXPECTED_PARAMETERS = {  # as counted_by_hand derives them from each architecture
     ("sparse_to_dense", "paper"): 14_644_257,
     ("sparse_to_dense", "small"): 1_553_369,
@@ -56,42 +58,38 @@ def _tiny(name):
     return config, config.init(jax.random.key(0))
 
 
-def _conv(k, a, b, bias=True):  # a k x k convolution from a to b channels
-    return k * k * a * b + (b if bias else 0)
-
-
 def _double_conv(a, c):  # U-Net: two bias-free 3x3 convolutions, each GroupNorm-ed (2c)
-    return _conv(3, a, c, False) + 2 * c + _conv(3, c, c, False) + 2 * c
+    return conv_params(3, a, c, False) + 2 * c + conv_params(3, c, c, False) + 2 * c
 
 
 def _unet_body(base, levels):  # RGB-D in (4 channels); down, bottom, then 1x1 up-convolutions to 4c + skip concat
     widths = [base * 2**level for level in range(levels + 1)]
     down = sum(_double_conv(a, c) for a, c in zip([4] + widths, widths))
-    up = sum(_conv(1, widths[level + 1], 4 * widths[level]) + _double_conv(2 * widths[level], widths[level])
+    up = sum(conv_params(1, widths[level + 1], 4 * widths[level]) + _double_conv(2 * widths[level], widths[level])
              for level in range(levels))
     return down + up
 
 
 def _sparse_to_dense(w, blocks):  # ResNet (basic blocks, bias-free, projection shortcuts) + up-projections
-    count = _conv(7, 4, w, False) + 2 * w
+    count = conv_params(7, 4, w, False) + 2 * w
     for stage, n in enumerate(blocks):
         c = w * 2**stage
         for i in range(n):
             a = c // 2 if i == 0 and stage > 0 else c
-            count += _conv(3, a, c, False) + 2 * c + _conv(3, c, c, False) + 2 * c
-            count += _conv(1, a, c, False) + 2 * c if a != c else 0
-    count += _conv(1, 8 * w, 4 * w, False) + 2 * 4 * w
+            count += conv_params(3, a, c, False) + 2 * c + conv_params(3, c, c, False) + 2 * c
+            count += conv_params(1, a, c, False) + 2 * c if a != c else 0
+    count += conv_params(1, 8 * w, 4 * w, False) + 2 * 4 * w
     for a in (4 * w, 2 * w, w, w // 2):  # lipjax.priors.network.UpProjection to a // 2 channels
-        count += 2 * (_conv(3, a, 2 * a) + a) + _conv(3, a // 2, a // 2) + a
-    return count + _conv(3, w // 4, 1)
+        count += up_projection_params(a, a // 2)
+    return count + conv_params(3, w // 4, 1)
 
 
 def counted_by_hand(model: str, config) -> int:
     """A baseline's parameters from its architecture (lipjax.networks), GroupNorm of c channels 2c."""
     if model == "sparse_to_dense":
         return _sparse_to_dense(config.width, config.blocks)
-    head = _conv(1, config.base_width, 1) if model == "unet" else (  # CSPN: depth + 8 affinities, 3x3 each
-        _conv(3, config.base_width, 1) + _conv(3, config.base_width, 8))
+    head = conv_params(1, config.base_width, 1) if model == "unet" else (  # CSPN: depth + 8 affinities, 3x3 each
+        conv_params(3, config.base_width, 1) + conv_params(3, config.base_width, 8))
     return _unet_body(config.base_width, config.levels) + head
 
 

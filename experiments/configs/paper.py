@@ -23,7 +23,7 @@ from __future__ import annotations
 import dataclasses
 
 from experiments.configs.base import END_TO_END_TYPES, OUTDOOR, OUTDOOR_MAX_DEPTH_M, Expected, end_to_end_model
-from experiments.configs.study import BRANCHES, METHODS, shipped_config, shipped_expected
+from experiments.configs.study import METHODS, shipped_config, shipped_expected, trunk_of
 from lipjax.train.config import TrainConfig
 from lipjax.train.discriminator import Discriminator
 
@@ -32,7 +32,7 @@ from lipjax.train.discriminator import Discriminator
 INDOOR_BUDGET = 30_000
 INDOOR_RATES = {"ma2018": 3.125e-3, "unet": 7.8125e-3, "cspn": 3.125e-3, "lip-cnn": 5e-4, "lip-fast": 8e-5}
 INDOOR_STUDY = {method: shipped_config(method, "indoor", budget=INDOOR_BUDGET,
-                                       learning_rate=INDOOR_RATES[BRANCHES.get(method, (method,))[0]])
+                                       learning_rate=INDOOR_RATES[trunk_of(method)])
                 for method in METHODS}
 
 LIP_CNN_INDOOR = INDOOR_STUDY["lip-cnn"]

@@ -36,6 +36,16 @@ TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
 # fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
 BRANCHES = {"lip-ad": ("lip-cnn", "depth"), "lip-ad-fast": ("lip-fast", "log_gradients")}
 METHODS = TRUNKS + tuple(BRANCHES)
+
+
+def trunk_of(method: str) -> str:
+    """The trunk whose runs `method` comes from: a branch's trunk, else the method itself."""
+    return BRANCHES[method][0] if method in BRANCHES else method
+
+
+def branches_of(trunk: str, methods: tuple[str, ...] = METHODS) -> list[str]:
+    """`trunk` and the branches of it among `methods`: the models one trunk run finishes."""
+    return [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in methods]
 # The cool-down: its share of a budget, its warm-up steps, and D's pretraining steps in LIP+AD's (at most a fifth of
 # them; the paper's LIP+AD configs use 50 D steps and 200 joint steps). It reads fresh frames: its data stream is
 # seed + COOLDOWN_SEED_OFFSET (the trunk's own seed would read the trunk's first batches again: a batch is a
@@ -137,7 +147,7 @@ def shipped_config(method: str, scene: str, *, learning_rate: float, budget: int
     images from the shipped trunk model <trunk>-<scene> (the study's starts from that trunk's model at budget - C,
     which is not shipped). The study makes the shipped model exactly, trunk and cool-down (python -m
     experiments.equal_budget with --seeds 0 --images BUDGET --curve BUDGET, a fresh --root and --scores)."""
-    trunk, cooldown = BRANCHES.get(method, (method,))[0], cooldown_images(budget, cooldown_fraction)
+    trunk, cooldown = trunk_of(method), cooldown_images(budget, cooldown_fraction)
     name = f"{method}-{scene}"
     if method in BRANCHES:
         return cooldown_config(method, scene, learning_rate=learning_rate, seed=SHIPPED_SEED,
