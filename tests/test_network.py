@@ -15,8 +15,8 @@ EXPECTED_PER_ITERATION = {"small": 493_721, "paper": 2_559_377, "tiny": 41_025}
 
 
 def counted_by_hand(prior) -> int:
-    """ProxNet's parameters from its widths: a k x k conv from a to b channels has k*k*a*b weights and b biases, a
-    GroupNorm of c channels 2c; the input is depth + RGB (4 channels)."""
+    """ProxNet's parameters from its widths (convolutions and up-projections counted by tests/helpers.py, a GroupNorm
+    of c channels 2c); the input is depth + RGB (4 channels)."""
     def bottleneck(a, w):  # 1x1 projection shortcut; 1x1 -> 3x3 -> 1x1 (expansion 4), each normalised
         return conv(1, a, 4 * w) + conv(1, a, w) + 2 * w + conv(3, w, w) + 2 * w + conv(1, w, 4 * w) + 8 * w
 

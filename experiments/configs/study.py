@@ -36,16 +36,6 @@ TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
 # fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
 BRANCHES = {"lip-ad": ("lip-cnn", "depth"), "lip-ad-fast": ("lip-fast", "log_gradients")}
 METHODS = TRUNKS + tuple(BRANCHES)
-
-
-def trunk_of(method: str) -> str:
-    """The trunk whose runs `method` comes from: a branch's trunk, else the method itself."""
-    return BRANCHES[method][0] if method in BRANCHES else method
-
-
-def branches_of(trunk: str, methods: tuple[str, ...] = METHODS) -> list[str]:
-    """`trunk` and the branches of it among `methods`: the models one trunk run finishes."""
-    return [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in methods]
 # The cool-down: its share of a budget, its warm-up steps, and D's pretraining steps in LIP+AD's (at most a fifth of
 # them; the paper's LIP+AD configs use 50 D steps and 200 joint steps). It reads fresh frames: its data stream is
 # seed + COOLDOWN_SEED_OFFSET (the trunk's own seed would read the trunk's first batches again: a batch is a
@@ -61,6 +51,16 @@ STUDY_ROOT = "runs/study"
 SHIPPED_SEED = 0
 # The tiny variant (tests; a check of the GPU script): tiny networks on 48x64 renders, 32x48 crops.
 TINY_SIZE, TINY_CROP = (48, 64), (32, 48)
+
+
+def trunk_of(method: str) -> str:
+    """The trunk whose runs `method` comes from: a branch's trunk, else the method itself."""
+    return BRANCHES[method][0] if method in BRANCHES else method
+
+
+def branches_of(trunk: str, methods: tuple[str, ...] = METHODS) -> list[str]:
+    """`trunk` and the branches of it among `methods`: the models one trunk run finishes."""
+    return [trunk] + [m for m, (t, _) in BRANCHES.items() if t == trunk and m in methods]
 
 
 def trunk_model(method: str, scene: str, tiny: bool = False):
