@@ -48,28 +48,28 @@ def test_shipped_model_reached_its_configs_expected_result(key):
         assert expected.note  # a budget the config alone does not give is explained
 
 
-def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates():
-    """Table I's learned rows are the equal-budget study's seed-0 models (experiments/configs/paper.py): each config
-    states the rate the study's tuning chose on the validation split (its committed tuning.json), and each shipped
-    model records that rate and the one budget, and its EXPECTED note the cool-down its last run was."""
+@pytest.mark.parametrize("scene", ["indoor", "outdoor"])
+def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates(scene):
+    """Tables I and II's learned rows are the equal-budget study's seed-0 models (experiments/configs/paper.py): each
+    config states the rate the study's tuning chose on the scene's validation split (its committed tuning.json), and
+    each shipped model records that rate and the one budget, and its EXPECTED note the cool-down its last run was."""
     from experiments.configs import paper
     from experiments.configs.study import BASES, BRANCHES, METHODS, shipped_expected
     from experiments.equal_budget import SCORES
     from experiments.study_report import best_rate
 
-    tuning = json.loads((pathlib.Path(SCORES) / "indoor" / "tuning.json").read_text())
-    assert paper.INDOOR_RATES == {trunk: best_rate({float(lr): r["val_rmse_m"] for lr, r in rates.items()})
-                                  for trunk, rates in tuning.items()}
+    tuning = json.loads((pathlib.Path(SCORES) / scene / "tuning.json").read_text())
+    assert paper.STUDY_RATES[scene] == {trunk: best_rate({float(lr): r["val_rmse_m"] for lr, r in rates.items()})
+                                        for trunk, rates in tuning.items()}
     for method in METHODS:
-        trunk = BRANCHES.get(method, (method,))[0]
-        meta = model_io.metadata(f"{method}-indoor")
-        assert meta["study"]["learning_rate"] == CONFIGS[f"{method.replace('-', '_')}_indoor"].learning_rate
-        assert meta["study"]["learning_rate"] == paper.INDOOR_RATES[trunk]
-        assert meta["images_seen"] == meta["study"]["budget_images"] == paper.INDOOR_BUDGET and meta["seed"] == 0
-        cooldown = meta["steps"] * BASES["indoor"].batch_size
+        trunk, key = BRANCHES.get(method, (method,))[0], f"{method.replace('-', '_')}_{scene}"
+        meta = model_io.metadata(f"{method}-{scene}")
+        assert meta["study"]["learning_rate"] == CONFIGS[key].learning_rate == paper.STUDY_RATES[scene][trunk]
+        assert meta["images_seen"] == meta["study"]["budget_images"] == paper.STUDY_BUDGET and meta["seed"] == 0
+        cooldown = meta["steps"] * BASES[scene].batch_size
         expected = shipped_expected(meta["val_metrics"]["rmse_m"], meta["images_seen"], cooldown,
                                     trunk if method in BRANCHES else None)
-        assert EXPECTED[f"{method.replace('-', '_')}_indoor"].note == expected.note
+        assert EXPECTED[key].note == expected.note
 
 
 def _replace_depths(monkeypatch) -> tuple[object, dict[int, tuple[TrainConfig, int, TrainConfig]]]:

@@ -210,7 +210,7 @@ def test_baseline_training_configs_copy_the_lip_runs():
         scene = key.split("_")[1]
         lip = configs.LIP_CNN_INDOOR if scene == "indoor" else configs.LIP_CNN_OUTDOOR
         assert config.name == key.replace("_", "-")
-        # only name, model and (the study's, rooms) tuned learning rate differ, and the end-to-end networks train
+        # only name, model and the study's tuned learning rate differ, and the end-to-end networks train
         # without the inverse-depth term
         assert config.inverse_depth_weight == 0.0
         same = dataclasses.replace(config, name=lip.name, model=lip.model, learning_rate=lip.learning_rate,

@@ -1,18 +1,19 @@
 """Training configurations (configs are code): each named config is one `dataclasses.replace` of a scene base
 (base.py: INDOOR, OUTDOOR, MIXED) and states the result its shipped weights reached (EXPECTED).
 
-    python -m experiments.train --config lip_cnn_indoor            # ~1 h on 2 idle CPU cores
+    python -m experiments.train --config lip_cnn_indoor            # ~1.5 h on 2 idle CPU cores
     python -m experiments.train --config lip_ad_indoor             # needs lip_cnn_indoor's weights first
     python -m experiments.train --config smoke                     # seconds after compilation: a check, not a model
     python -m experiments.train --config lip_cnn_nyu --set data.root=DIR --export runs/lip_cnn_nyu/model   # real data
 
-Families: paper.py (LIP+CNN, LIP+AD and the end-to-end baselines on the synthetic scenes), fast.py (the shipped
-fast-prox models and lip-any), real.py (NYU v2, KITTI DC, TartanAir, your folder). Nothing is exported unless --export
-PATH is given. How the shipped weights were trained: docs/training.md.
+Families: paper.py (LIP+CNN, LIP+AD with the paper's prox and the fast prox, and the end-to-end baselines on the
+synthetic scenes: the equal-budget study's), lip_any.py (the default model), real.py (NYU v2, KITTI DC, TartanAir,
+your folder). Nothing is exported unless --export PATH is given. How the shipped weights were trained:
+docs/training.md.
 """
 from __future__ import annotations
 
-from experiments.configs import fast, paper, real
+from experiments.configs import lip_any, paper, real
 from experiments.configs.base import OUTDOOR_DATA, Expected
 from experiments.configs.paper import BASELINE_CONFIGS, LIP_CNN_INDOOR, LIP_CNN_OUTDOOR
 from lipjax.model import LIPConfig
@@ -30,10 +31,10 @@ SMOKE = TrainConfig(
 )
 
 CONFIGS: dict[str, TrainConfig] = {
-    **paper.CONFIGS, **fast.CONFIGS, "smoke": SMOKE, **BASELINE_CONFIGS, **real.CONFIGS, **real.REAL_DATA_BASELINES,
+    **paper.CONFIGS, **lip_any.CONFIGS, "smoke": SMOKE, **BASELINE_CONFIGS, **real.CONFIGS, **real.REAL_DATA_BASELINES,
 }
 # Keyed as CONFIGS: the configs whose weights are shipped (lipjax/weights/<config name>), and what they reached.
-EXPECTED: dict[str, Expected] = {**paper.EXPECTED, **fast.EXPECTED}
+EXPECTED: dict[str, Expected] = {**paper.EXPECTED, **lip_any.EXPECTED}
 
 
 def get_config(name: str, overrides: dict[str, str] | None = None) -> TrainConfig:

@@ -1,7 +1,7 @@
 """The scene bases every named config is built from, in one `dataclasses.replace`: INDOOR, OUTDOOR and MIXED.
 
 A base holds what its scene needs (data, model, loss) and the synthetic LIP+CNN schedule; a named config
-(experiments/configs/paper.py, fast.py, real.py) changes the run: its name, model variant, data source, budget.
+(experiments/configs/paper.py, lip_any.py, real.py) changes the run: its name, model variant, data source, budget.
 Why each choice was made, and the runs behind it: docs/decisions/ and docs/training.md, "How the shipped models were
 trained" (the run history: `git log -p -- docs/training.md`).
 """
@@ -132,7 +132,7 @@ OUTDOOR = TrainConfig(
 )
 # Rooms and streets: the fast prox (it never sees a metric depth) from the "auto" fill (nearest on scan
 # lines, linear elsewhere: benchmarks/initial_estimate.py), each frame's error in units of its own sample scale. No
-# schedule: its config (fast.py, lip_any) sets it.
+# schedule: its config (lip_any.py) sets it.
 MIXED = TrainConfig(
     name="mixed", model=fast_model(OUTDOOR_MAX_DEPTH_M, "auto"), data=MIXED_DATA,
     batch_size=8, loss="l1", loss_scale="samples",

@@ -14,8 +14,7 @@ import dataclasses
 from typing import Any
 
 from experiments.configs.base import (END_TO_END_DEPTH_SCALE, END_TO_END_TYPES, INDOOR, INDOOR_MAX_DEPTH_M, OUTDOOR,
-                                      OUTDOOR_MAX_DEPTH_M)
-from experiments.configs.paper import baseline
+                                      OUTDOOR_MAX_DEPTH_M, end_to_end_model)
 from lipjax.train.config import DataConfig, TrainConfig
 from lipjax.train.discriminator import Discriminator
 from lipjax.train.folder import folder_config
@@ -68,8 +67,18 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_cnn_tartanair": LIP_CNN_TARTANAIR,
     "lip_cnn_folder": LIP_CNN_FOLDER,
 }
+
+
+def baseline(base: TrainConfig, name: str, method: str, **run) -> TrainConfig:
+    """The LIP+CNN run `run` (data, batch, budget, schedule) of scene `base` with the end-to-end network `method`
+    (base.END_TO_END_TYPES) in place of LIP, seeing depth in units of each frame's samples (END_TO_END_DEPTH_SCALE),
+    without the inverse-depth term: from random initialisation it diverged."""
+    model = end_to_end_model(method, base.model.max_depth_m, depth_scale=END_TO_END_DEPTH_SCALE)
+    return dataclasses.replace(base, name=name, model=model, inverse_depth_weight=0.0, **run)
+
+
 REAL_DATA_BASELINES: dict[str, TrainConfig] = {
-    f"{key}_{data}": baseline(base, f"{key}-{data}", key, depth_scale=END_TO_END_DEPTH_SCALE, **run)
+    f"{key}_{data}": baseline(base, f"{key}-{data}", key, **run)
     for key in END_TO_END_TYPES
     for data, base, run in (("nyu", INDOOR, NYU_RUN), ("kitti", OUTDOOR, KITTI_RUN),
                             ("tartanair", OUTDOOR, TARTANAIR_RUN))

@@ -33,7 +33,7 @@ BASES = {"indoor": INDOOR, "outdoor": OUTDOOR}
 END_TO_END = tuple(END_TO_END_TYPES)  # the end-to-end networks (lipjax.networks)
 TRUNKS = END_TO_END + ("lip-cnn", "lip-fast")  # trained from random weights
 # branch -> (its trunk, what D sees): the paper's D on depth for the paper's prox; on log-depth gradients for the
-# fast prox (experiments/configs/fast.py: on depth / max_depth it stayed at chance).
+# fast prox (its LIP+AD runs of 2026-11: on depth / max_depth D stayed at chance).
 BRANCHES = {"lip-ad": ("lip-cnn", "depth"), "lip-ad-fast": ("lip-fast", "log_gradients")}
 METHODS = TRUNKS + tuple(BRANCHES)
 # The cool-down: its share of a budget, its warm-up steps, and D's pretraining steps in LIP+AD's (at most a fifth of

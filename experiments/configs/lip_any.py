@@ -1,44 +1,17 @@
-"""The fast prox (lipjax.priors.fast "fast") on streets, its LIP+AD, and lip-any, the default model for rooms and
-streets; each one `dataclasses.replace` of its scene base (base.py). The rooms' fast-prox models (lip-fast-indoor,
-lip-ad-fast-indoor) are the equal-budget study's (paper.py).
+"""lip-any, the default model for rooms and streets: one `dataclasses.replace` of the mixed scene base (base.py).
+The per-scene fast-prox models (lip-fast-<scene>, lip-ad-fast-<scene>) are the equal-budget study's (paper.py).
 
-The prox has a third of the paper-style G's FLOPs per frame and trains ~2.7x faster here, so it trains longer for
-the same CPU time. The runs (commands, overrides, curves): docs/training.md, "How the shipped models were trained" (the
-run history: `git log -p -- docs/training.md`).
-
-    lipjax data render --kind outdoor --split train --count 10000 --out runs/data/outdoor-train-128x416
-    python -m experiments.train --config lip_fast_outdoor --set data.source=rendered \\
-        --set data.root=runs/data/outdoor-train-128x416 --export runs/export/lip-fast-outdoor
+The fast prox (lipjax.priors.fast "fast") has a third of the paper-style G's FLOPs per frame and trains ~2.7x faster
+here, so it trains longer for the same CPU time. The runs (commands, overrides, curves): docs/training.md, "How the
+shipped models were trained" (the run history: `git log -p -- docs/training.md`).
 """
 from __future__ import annotations
 
 import dataclasses
 
-from experiments.configs.base import (MIXED, OUTDOOR, OUTDOOR_DATA, OUTDOOR_INITIAL_ESTIMATE, OUTDOOR_MAX_DEPTH_M,
-                                      Expected, fast_model)
-from lipjax.data.augment import DEFAULT_TRAINING as DEFAULT_AUGMENT
+from experiments.configs.base import MIXED, Expected
 from lipjax.train.config import TrainConfig
-from lipjax.train.discriminator import Discriminator
 
-# Zoom >= 1 only outdoors: the renders are no taller than the crop (lipjax.data.augment).
-FAST_OUTDOOR_DATA = dataclasses.replace(OUTDOOR_DATA, augment=DEFAULT_AUGMENT)
-FAST_OUTDOOR_MODEL = fast_model(OUTDOOR_MAX_DEPTH_M, OUTDOOR_INITIAL_ESTIMATE)
-
-# Streets: from the fast prox trained on rooms (its 64,000-image model of 2026-11; the rooms' shipped fast-prox
-# models are the equal-budget study's now: experiments/configs/paper.py).
-LIP_FAST_OUTDOOR = dataclasses.replace(
-    OUTDOOR, name="lip-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA, init_from="lip-fast-indoor",
-    g_steps=1300, learning_rate=3e-4, warmup_steps=100, eval_every=500, checkpoint_every=100,
-)
-# D sees differences of log depth: on depth / max_depth it stayed at chance. After a run whose cosine schedule has
-# decayed to zero, the joint steps need a small learning rate (at 2e-4 the run ended worse than its start).
-LIP_AD_FAST_OUTDOOR = dataclasses.replace(
-    OUTDOOR, name="lip-ad-fast-outdoor", model=FAST_OUTDOOR_MODEL, data=FAST_OUTDOOR_DATA,
-    init_from="lip-fast-outdoor",
-    g_steps=0, d_steps=100, adv_steps=300, learning_rate=5e-5, warmup_steps=20, adv_weight=1e-3,
-    discriminator=Discriminator(max_depth_m=OUTDOOR_MAX_DEPTH_M, inputs="log_gradients"),
-    eval_every=500, checkpoint_every=100,
-)
 # lip-any: one model for rooms and streets, any sensor (issue 22), the default model; each run resumes from the
 # shipped lip-any (its first run started from lip-fast-indoor: EXPECTED's note).
 LIP_ANY = dataclasses.replace(
@@ -49,17 +22,11 @@ LIP_ANY = dataclasses.replace(
 )
 
 CONFIGS: dict[str, TrainConfig] = {
-    "lip_fast_outdoor": LIP_FAST_OUTDOOR,
-    "lip_ad_fast_outdoor": LIP_AD_FAST_OUTDOOR,
     "lip_any": LIP_ANY,
 }
 
 # What the shipped weights reached (lipjax/weights/<name>.json); all trained on --set data.source=rendered.
 EXPECTED: dict[str, Expected] = {
-    "lip_fast_outdoor": Expected(
-        val_rmse_m=3.557457, images_seen=74_400, budget_from_config=False,
-        note="this config from the 64,000-image lip-fast-indoor (from the shipped one: 110,400 images)"),
-    "lip_ad_fast_outdoor": Expected(val_rmse_m=3.454171, images_seen=77_600),
     "lip_any": Expected(
         val_rmse_m=2.081812, images_seen=1_572_640, budget_from_config=False,
         note="its runs: 4,000 steps from the 100,000-image lip-fast-indoor at learning rate 2e-4 with z0 the "
