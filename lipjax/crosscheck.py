@@ -17,7 +17,7 @@ it). Otherwise, over all n:
 
 and every measured pixel is set back. Where the model is the better fill (the renders of
 `benchmarks/generalisation.py` with the 972,640-image lip-any: 0.662612 -> 0.662305 x linear) w stays 1 on most
-frames (it fires on some denser inputs); where it is not (a street model on rooms: 1.23 -> 0.90 x linear) the output
+frames (it fires on some denser inputs); where it is not (a street model on rooms: 1.48 -> 0.91 x linear) the output
 leans on the linear fill. Folds, not one held-out fifth (docs/decisions/0015-cross-check-by-folds.md): with 200 points
 one fifth is 40 depths, too few for the test to see a model that loses (one fold: 0.662356 and 0.98 above). Scan lines
 are not checked: random held-out returns lie a pixel from their neighbours on the same line, where every fill is right,

@@ -16,11 +16,13 @@ WEIGHTS_DIR = pathlib.Path(__file__).parent / "weights"
 # sensor, which `lipjax complete` and lipjax.complete run on every input. The rule, fixed before the real frames were
 # scored: lip-any is the default for every input if it is within 10 % of the per-scene models on the synthetic tables
 # (Table I 0.1544 m against lip-ad-fast-indoor's 0.1762, bound 0.1938; Table II 3042 mm against lip-ad-fast-outdoor's
-# 3661, bound 4027: `python -m experiments.nyu_200pts`, `python -m experiments.kitti_dc`, at 1,572,640 images; 0.1894 m
-# and 4016 mm when it was first chosen, at 164,000). The rooms' per-scene models are the equal-budget study's since
-# 2026-12-06 (30,000 images each; the best, lip-cnn-indoor, 0.2017 m). The per-scene models stay, for the
-# paper's tables and by name. Per scene, for what still names a scene's model: the model `lipjax train` starts from
-# (lipjax.train.folder.default_init), the input checks' advice, `lipjax models`' DEFAULT column.
+# 3661, bound 4027: `python -m experiments.nyu_200pts`, `python -m experiments.kitti_dc`, at 1,572,640 images;
+# 0.1894 m and 4016 mm when it was first chosen, at 164,000). The per-scene models are the equal-budget study's since
+# 2026-12-06 (rooms) and 2026-12-07 (streets), 30,000 images each; against the best of them lip-any still holds:
+# Table I 0.1544 m against lip-cnn-indoor's 0.2017, Table II 3042 mm against lip-cnn-outdoor's 2934, bound 3228. The
+# per-scene models stay, for the paper's tables and by name. Per scene, for what still names a scene's model: the
+# model `lipjax train` starts from (lipjax.train.folder.default_init), the input checks' advice, `lipjax models`'
+# DEFAULT column.
 DEFAULT_MODELS = {"indoor": DEFAULT_MODEL, "outdoor": DEFAULT_MODEL}
 
 
