@@ -3,7 +3,8 @@
 Writes into the results folder (docs/results by default):
   equal_budget.json   {"indoor": {"<method>": {"images", "seeds", "rmse_m", "mae_m"}, "linear": {...},
                        "nearest": {...}}, "outdoor": {...}, "details": {tuning, curve, iterations, paired tests}}
-  equal_budget.md     per scene, mean +- standard deviation over seeds at the budget, and the paired tests
+  equal_budget.md     per scene, mean +- standard deviation over seeds at the budget, the methods still falling
+                      steeply at the end of their curve (STEEP_CHANGE), and the paired tests
   equal_budget_curve.png        test RMSE against training images (the data-efficiency curve), rooms
   equal_budget_iterations.png   test RMSE against the ADMM iteration count K of the LIP runs (Fig. 4a)
 
@@ -29,6 +30,9 @@ from lipjax.utils import written_whole
 PAIRS = (("lip-ad", "best end-to-end"), ("lip-ad", "lip-cnn"), ("lip-ad-fast", "best end-to-end"))
 BOOTSTRAP_DRAWS = 10_000
 BOOTSTRAP_SEED = 0
+# A method still falls steeply at the end of its curve when its RMSE fell by more than this over its last step
+# (curve_change), e.g. 30,000 -> 100,000 images (decision 0028, fixed before the second 100,000-image score).
+STEEP_CHANGE = -0.05
 
 
 def bootstrap_interval(diff: np.ndarray, draws: int = BOOTSTRAP_DRAWS, level: float = 0.95) -> tuple[float, float]:
@@ -150,6 +154,15 @@ def curve_change(scores: list[dict]) -> dict:
     return out
 
 
+def still_falling(changes: dict, threshold: float = STEEP_CHANGE) -> dict[str, dict]:
+    """{method: the last step of its curve, {"from", "to", "seeds", "change"}} (curve_change's steps) for the
+    methods whose RMSE fell by more than -`threshold` over that step: those still falling steeply at the largest
+    budget they have reached."""
+    last = {method: max(steps, key=int) for method, steps in changes.items() if steps}
+    return {method: {**changes[method][n], "to": int(n)} for method, n in last.items()
+            if changes[method][n]["change"] < threshold}
+
+
 def _curve_text(points: dict, changes: dict) -> str:
     """'10,000: 0.229, 30,000: 0.201 (-12%)': the mean RMSE at each budget, and its change from the budget before."""
     text = []
@@ -207,6 +220,11 @@ def markdown(doc: dict, images: int) -> str:
             else:
                 lines.append(f"| {method} (no training) | | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
                              f"{row['rmse_m'] / linear:.2f}x | |")
+        if changes:  # a curve of two budgets or more
+            falling = ", ".join(f"{m} ({s['from']:,} -> {s['to']:,} images: {s['change']:+.0%})"
+                                for m, s in still_falling(changes).items())
+            lines += ["", f"Still falling steeply at the end of its curve (RMSE more than {-STEEP_CHANGE:.0%} below "
+                      f"the budget before, decision 0028): {falling or 'none'}."]
         lines += tuning_table(doc["details"][scene]["tuning_val_rmse_m"])
         tests = doc["details"][scene]["paired_tests"]
         if tests:
@@ -334,6 +352,7 @@ def write_report(study, scores_left: list[str], keep, out: pathlib.Path | None =
         doc["details"][scene] = {
             "tuning_val_rmse_m": json.loads(tuning_path.read_text()) if tuning_path.exists() else {},
             "curve_rmse_m": curve(scores), "curve_change": curve_change(scores),
+            "still_falling": still_falling(curve_change(scores)),
             "rmse_m_by_iterations": iterations(scores, study.images),
             "paired_tests": [t for t in tests if t], "test_frames": len(scores[0]["per_image"]),
         }

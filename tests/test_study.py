@@ -314,6 +314,13 @@ def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
     assert "10000" not in change
     text = study_report._curve_text({"10000": [0.3, 0.2, 0.5], "30000": [0.24, 0.18]}, change)
     assert text == "10,000: 0.333, 30,000: 0.210 (-15%)"
+    # still falling steeply: judged on each method's last step only, against the threshold fixed in advance
+    flat = [{"method": "cspn", "seed": 0, "images": n, "rmse_m": v} for n, v in ((10_000, 0.30), (30_000, 0.2880))]
+    changes = study_report.curve_change(scores + flat)  # cspn: -4 %, above the -5 % threshold
+    assert study_report.still_falling(changes) == {"unet": {"from": 30_000, "to": 100_000, "seeds": [0],
+                                                            "change": pytest.approx(-0.10)}}
+    assert set(study_report.still_falling(changes, threshold=-0.03)) == {"unet", "cspn"}
+    assert study_report.still_falling(changes, threshold=-0.11) == {}
 
 
 def test_the_verdict_is_decision_0028s_rule_interval_excluding_zero_and_every_seed():
