@@ -352,12 +352,12 @@ def write_report(study, scores_left: list[str], keep, out: pathlib.Path | None =
         doc["details"][scene] = {
             "tuning_val_rmse_m": json.loads(tuning_path.read_text()) if tuning_path.exists() else {},
             "curve_rmse_m": curve(scores), "curve_change": curve_change(scores),
-            "still_falling": still_falling(curve_change(scores)),
             "rmse_m_by_iterations": iterations(scores, study.images),
             "paired_tests": [t for t in tests if t], "test_frames": len(scores[0]["per_image"]),
         }
         names = {"indoor": "rooms, 200 points (Table I)", "outdoor": "streets, 64 beams (Table II)"}
-        plot_curve(out / f"equal_budget_curve_{scene}.png", curve(scores), classical, names[scene])
+        plot_curve(out / f"equal_budget_curve_{scene}.png", doc["details"][scene]["curve_rmse_m"], classical,
+                   names[scene])
         if doc["details"][scene]["rmse_m_by_iterations"]:
             plot_iterations(out / f"equal_budget_iterations_{scene}.png", doc["details"][scene][
                 "rmse_m_by_iterations"], f"{names[scene]}, {study.images:,} images",
