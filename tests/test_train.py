@@ -340,11 +340,23 @@ def test_train_command_without_its_data_set_is_one_line(tmp_path, capsys):
                                                    "found"), lines
 
 
-def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[int], list[int], list[int], str]:
+def _loader_workers(pid: int) -> set[int]:
+    """The grain worker processes (multiprocessing's spawned children) of process `pid`."""
+    def spawned(child: int) -> bool:
+        try:
+            return b"spawn_main" in pathlib.Path(f"/proc/{child}/cmdline").read_bytes()
+        except OSError:
+            return False
+    return {child for child in children(pid) if spawned(child)}
+
+
+def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int, group: bool,
+                        at_worker_start: bool = False) -> tuple[int, set[int], list[int], list[int], str]:
     """Starts `experiments.train --config smoke` (2 loader workers, no checkpoint due) in a process group of its
-    own, as a terminal's foreground job, and sends `signum` once it has logged 2 steps: to the process (SIGTERM) or
-    to its whole group (SIGINT, as Ctrl-C). Returns (exit status, the loader worker pids, the logged steps, the
-    saved checkpoint steps, its output)."""
+    own, as a terminal's foreground job, and sends `signum` once it has logged 2 steps (at_worker_start: as soon
+    as its first loader worker process exists, which then takes seconds to import its modules): to the process, or
+    to its whole group (as Ctrl-C, `timeout` and batch schedulers do). Returns (exit status, the loader worker
+    pids, the logged steps, the saved checkpoint steps, its output)."""
     workdir = tmp_path / "run"
     cmd = [sys.executable, "-m", "experiments.train", "--config", "smoke", "--workdir", str(workdir), "--no-progress",
            "--set", "g_steps=100000", "--set", "data.num_workers=2", "--set", "checkpoint_every=100000",
@@ -355,11 +367,15 @@ def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int) -> tuple[int, set[i
     metrics = workdir / "metrics.jsonl"
     try:
         deadline = time.time() + 240
-        while not (metrics.exists() and metrics.read_text().count("\n") >= 2) and time.time() < deadline:
+        if at_worker_start:
+            while not _loader_workers(proc.pid) and time.time() < deadline:
+                time.sleep(0.01)
+        while not at_worker_start and not (metrics.exists() and metrics.read_text().count("\n") >= 2) \
+                and time.time() < deadline:
             time.sleep(0.2)
         workers = children(proc.pid)
         assert workers, "the run should have a loader worker process"
-        os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
+        os.killpg(proc.pid, signum) if group else proc.send_signal(signum)
         status = proc.wait(timeout=60)
     finally:
         proc.kill()
@@ -376,11 +392,13 @@ def _workers_end(workers: set[int]) -> bool:
 
 
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
-def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
-    """A killed run (SIGTERM) saves the step it was in, although no checkpoint was due, exits with 143 and takes
-    its loader worker processes with it, leaving no shared memory behind; the checkpoint restores at that step,
-    with its data position."""
-    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGTERM)
+@pytest.mark.parametrize("group", [False, True], ids=["process", "group"])
+def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path, group):
+    """A killed run (SIGTERM to the process, or to its whole process group as `timeout` and batch schedulers send
+    it, loader workers included) saves the step it was in, although no checkpoint was due, exits with 143 and
+    takes its loader worker processes with it, leaving no shared memory behind; the checkpoint restores at that
+    step, with its data position."""
+    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGTERM, group)
     assert status == 143
     assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
     assert _workers_end(workers), "loader workers outlived the run"
@@ -394,11 +412,25 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
 
 
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_sigterm_while_the_loader_workers_start_stops_the_run_as_asked(tmp_path):
+    """SIGTERM to the whole process group while the loader workers are still starting (before they can ignore
+    it) kills them; the run, asked to stop before its first step, exits with 143 and says why, without a
+    traceback, and nothing is saved (no step was trained)."""
+    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGTERM, group=True,
+                                                               at_worker_start=True)
+    assert status == 143, text[-3000:]
+    assert logged == [] and saved == [], (logged, saved)
+    assert "[lipjax] SIGTERM: a data loader worker ended with it before step 0; stopping" in text, text[-3000:]
+    assert "Traceback" not in text and "leaked shared_memory" not in text, text[-3000:]
+    assert _workers_end(workers), "loader workers outlived the run"
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
 def test_ctrl_c_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_path):
     """Ctrl-C as a terminal sends it (SIGINT to the whole process group, loader workers included) saves the step
     in progress, although no checkpoint was due, says so, exits with 130, and the workers end with the run,
     leaving no shared memory behind."""
-    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGINT)
+    status, workers, logged, saved, text = _signal_a_smoke_run(tmp_path, signal.SIGINT, group=True)
     assert status == 130
     assert len(logged) >= 2 and saved == [logged[-1]], (logged, saved)  # the step in progress, none before it
     checkpoints = tmp_path / "run" / "checkpoints"
@@ -533,9 +565,9 @@ def killed_reference(tmp_path_factory):
 def test_a_run_killed_at_a_random_step_resumes_bit_identical_and_leaves_no_process(killed_reference, tmp_path,
                                                                                    signum):
     """A real training process killed once it has logged a seeded random step (the signal may land a step or two
-    later) by SIGKILL (nothing saved: resume from the last periodic checkpoint), SIGTERM or Ctrl-C (the step in
-    progress saved) resumes to parameters and optimiser state bit-identical to an uninterrupted run, and none of its
-    processes outlives it."""
+    later) by SIGKILL to the process (nothing saved: resume from the last periodic checkpoint; its loader workers
+    exit when orphaned), or SIGTERM or Ctrl-C to its whole process group (the step in progress saved) resumes to
+    parameters and optimiser state bit-identical to an uninterrupted run, and none of its processes outlives it."""
     kill_after = int(np.random.default_rng(int(signum)).integers(2, KILLED.total_steps - 4))
     workdir = tmp_path / "run"
     script = ("import sys; sys.path.insert(0, 'tests'); from test_train import KILLED; from lipjax.train import loop; "
@@ -548,7 +580,7 @@ def test_a_run_killed_at_a_random_step_resumes_bit_identical_and_leaves_no_proce
         while _steps_logged(metrics) < kill_after and time.time() < deadline:
             time.sleep(0.02)
         family = children(proc.pid) | {proc.pid}
-        os.killpg(proc.pid, signum) if signum == signal.SIGINT else proc.send_signal(signum)
+        os.killpg(proc.pid, signum) if signum != signal.SIGKILL else proc.send_signal(signum)
         proc.wait(timeout=60)
     finally:
         proc.kill()

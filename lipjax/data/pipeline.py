@@ -251,15 +251,17 @@ def _grain():
 
 def _single_threaded_worker(worker_index: int, worker_count: int) -> None:
     """Each worker process uses one core: OpenCV's own thread pool would make the workers compete for cores.
-    Workers ignore SIGINT: a terminal's Ctrl-C reaches the whole process group, and the training loop, not each
-    worker, decides what it means (lipjax.train.loop: save the step in progress, then stop the workers). A worker
-    ends with the run even when the run is killed (SIGKILL): `lipjax.utils.exit_when_orphaned`."""
+    Workers ignore SIGINT and SIGTERM: a terminal's Ctrl-C, `timeout` and a batch scheduler's preemption signal the
+    whole process group, and the training loop, not each worker, decides what the signal means (lipjax.train.loop:
+    save the step in progress, then stop the workers); a worker that died of it first would take that step's batch
+    with it. A worker ends with the run even when the run is killed (SIGKILL): `lipjax.utils.exit_when_orphaned`."""
     import signal
 
     import cv2
 
     cv2.setNumThreads(1)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, signal.SIG_IGN)
     exit_when_orphaned()
 
 

@@ -140,6 +140,21 @@ def _signals_as_exit(save_first: bool):
         raise SystemExit(128 + stop.signum)
 
 
+def _next_batch(loader: TrainLoader, stop: _Stop, step: int) -> Batch:
+    """The loader's batch of `step`. A worker that was still starting when the run's stop signal reached its whole
+    process group (Ctrl-C, `timeout`, a batch scheduler) dies of it, before it can ignore it (pipeline's worker
+    init): with the stop already asked for, the run then stops as asked (SystemExit(128 + signal)), keeping its
+    last checkpoint, instead of failing on the loader."""
+    try:
+        return next(loader)
+    except Exception:
+        if not stop.is_set():
+            raise
+        print(f"[lipjax] {signal.Signals(stop.signum).name}: a data loader worker ended with it before step {step}; "
+              "stopping with the last checkpoint saved (run again to resume)", file=sys.stderr, flush=True)
+        raise SystemExit(128 + stop.signum) from None
+
+
 def _resume(config: TrainConfig, manager: CheckpointManager, is_main: bool) -> tuple[TrainState, dict]:
     """(state, checkpoint metadata): the latest checkpoint's, else a fresh state ({} metadata)."""
     state = init_state(config, _initial_g_params(config))
@@ -262,7 +277,7 @@ def train(
     try:
         with _signals_as_exit(save_first=process_count == 1) as stop, loader:
             for step in range(start, end):
-                batch = next(loader)
+                batch = _next_batch(loader, stop, step)
                 phase = config.phase(step)
                 state, metrics = getattr(steps, phase)(state, shard_batch(batch, mesh), jax.random.fold_in(rng, step))
                 shown.images += config.batch_size
