@@ -52,7 +52,8 @@ def test_shipped_model_reached_its_configs_expected_result(key):
 def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates(scene):
     """Tables I and II's learned rows are the equal-budget study's seed-0 models (experiments/configs/paper.py): each
     config states the rate the study's tuning chose on the scene's validation split (its committed tuning.json), and
-    each shipped model records that rate and the one budget, and its EXPECTED note the cool-down its last run was."""
+    each shipped model records that rate and the scene's one budget (STUDY_BUDGET[scene]), and its EXPECTED note the
+    cool-down its last run was."""
     from experiments.configs import paper
     from experiments.configs.study import BASES, BRANCHES, METHODS, shipped_expected
     from experiments.equal_budget import SCORES
@@ -65,7 +66,7 @@ def test_the_shipped_study_models_are_the_studys_at_its_tuned_rates(scene):
         trunk, key = BRANCHES.get(method, (method,))[0], f"{method.replace('-', '_')}_{scene}"
         meta = model_io.metadata(f"{method}-{scene}")
         assert meta["study"]["learning_rate"] == CONFIGS[key].learning_rate == paper.STUDY_RATES[scene][trunk]
-        assert meta["images_seen"] == meta["study"]["budget_images"] == paper.STUDY_BUDGET and meta["seed"] == 0
+        assert meta["images_seen"] == meta["study"]["budget_images"] == paper.STUDY_BUDGET[scene] and meta["seed"] == 0
         cooldown = meta["steps"] * BASES[scene].batch_size
         expected = shipped_expected(meta["val_metrics"]["rmse_m"], meta["images_seen"], cooldown,
                                     trunk if method in BRANCHES else None)

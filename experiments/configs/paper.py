@@ -2,12 +2,12 @@
 the end-to-end baselines.
 
 The shipped models of both scenes (Table I, rooms; Table II, streets) are the equal-budget study's seed-0 models at
-STUDY_BUDGET training images each (issue 52; experiments/equal_budget.py, experiments/configs/study.py), so that the
-tables compare equal budgets, each at the learning rate the study's tuning chose on the scene's validation split. A
-trunk's config (lip_cnn_<scene>, lip_fast_<scene>, the end-to-end networks) is its run from random weights to the
-cool-down's start; LIP+AD's (lip_ad_<scene>, lip_ad_fast_<scene>) is its adversarial cool-down, here from the
-shipped trunk model. The study made the shipped models, trunk and cool-down, and makes them again exactly (it tunes
-again, in a fresh --scores):
+STUDY_BUDGET[scene] training images each (issue 52; experiments/equal_budget.py, experiments/configs/study.py), so
+that each table compares equal budgets, each model at the learning rate the study's tuning chose on the scene's
+validation split. A trunk's config (lip_cnn_<scene>, lip_fast_<scene>, the end-to-end networks) is its run from
+random weights to the cool-down's start; LIP+AD's (lip_ad_<scene>, lip_ad_fast_<scene>) is its adversarial cool-down,
+here from the shipped trunk model. The study made the shipped models, trunk and cool-down, and makes them again
+exactly (it tunes again, in a fresh --scores):
 
     python -m experiments.equal_budget --scene indoor --seeds 0 --images 30000 --curve 30000 \\
         --methods lip-cnn,lip-ad --root runs/remake --scores runs/remake/scores
@@ -19,14 +19,15 @@ from experiments.configs.base import END_TO_END_TYPES, Expected
 from experiments.configs.study import METHODS, SCENES, shipped_config, shipped_expected, trunk_of
 from lipjax.train.config import TrainConfig
 
-# The study's budget of the shipped models, and each trunk's learning rate per scene: the lowest validation RMSE
-# after 3,000 images (experiments/study_scores/<scene>/tuning.json; tests/test_configs.py reads it).
-STUDY_BUDGET = 30_000
+# Per scene: the study's budget of the shipped models (the largest it reached for all seven methods of the scene),
+# and each trunk's learning rate, the lowest validation RMSE after 3,000 images
+# (experiments/study_scores/<scene>/tuning.json; tests/test_configs.py reads it).
+STUDY_BUDGET = {"indoor": 30_000, "outdoor": 30_000}
 STUDY_RATES = {
     "indoor": {"ma2018": 3.125e-3, "unet": 7.8125e-3, "cspn": 3.125e-3, "lip-cnn": 5e-4, "lip-fast": 8e-5},
     "outdoor": {"ma2018": 3.125e-3, "unet": 1.25e-3, "cspn": 3.125e-3, "lip-cnn": 1.25e-3, "lip-fast": 5e-4},
 }
-STUDY = {scene: {method: shipped_config(method, scene, budget=STUDY_BUDGET,
+STUDY = {scene: {method: shipped_config(method, scene, budget=STUDY_BUDGET[scene],
                                         learning_rate=STUDY_RATES[scene][trunk_of(method)])
                  for method in METHODS}
          for scene in SCENES}
