@@ -22,8 +22,8 @@ Stages, each skipped when its output exists, so the study continues across sessi
 run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
 (experiments/study_scores, committed: a new machine goes on from them); runs, checkpoints and models stay in --root
 (runs/study, not committed) except the trunk runs in progress at a session's end: --save-in-progress copies each
-(its newest checkpoint and the exports still needed) to experiments/warm_starts/study/<scene>/<trunk>/lr<rate>/seed<k>,
-committed once a session, and a new machine continues from there:
+(its newest checkpoint and the exports still needed) to --warm-starts (experiments/warm_starts/study/<scene>/<trunk>/
+lr<rate>/seed<k>), committed once a session, and a new machine continues from there:
   1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS and,
      while the best is the grid's edge, rates beyond it (`next_rate`; seed 0, the validation split: never the test
      split); the same small budget for every trunk;
@@ -93,7 +93,7 @@ class Study:
     tiny: bool = False
     methods: tuple[str, ...] = METHODS
     workers: int = 1  # loader processes of every run (data.num_workers: how fast, not what it reads)
-    warm_starts: pathlib.Path | None = WARM_STARTS  # committed workdirs to go on from (None: never; the tiny check)
+    warm_starts: pathlib.Path | None = WARM_STARTS  # workdirs to go on from, committed (None: never)
 
     def __post_init__(self):
         for n in (self.images, self.tune_images, *[c for cs in self.curve.values() for c in cs]):
@@ -549,7 +549,9 @@ def main(argv=None) -> None:
     p.add_argument("--tiny", action="store_true", help="tiny networks on 48x64 frames: a check, not a result")
     p.add_argument("--plan", action="store_true", help="print what is done and what is left; run nothing")
     p.add_argument("--report", action="store_true", help="write the report from the scores so far; train nothing")
-    p.add_argument("--save-in-progress", action="store_true", help=f"copy the runs not finished to {WARM_STARTS} "
+    p.add_argument("--warm-starts", help=f"runs in progress to go on from, and where --save-in-progress copies them "
+                   f"(default {WARM_STARTS}, committed; with --tiny, <root>/warm-starts)")
+    p.add_argument("--save-in-progress", action="store_true", help="copy the runs not finished to --warm-starts "
                    "(commit it at a session's end: a new machine goes on from there); train nothing")
     p.add_argument("--no-progress", action="store_true")
     args = p.parse_args(argv)
@@ -561,23 +563,23 @@ def main(argv=None) -> None:
     scores = pathlib.Path(args.scores or (pathlib.Path(args.root) / "scores" if args.tiny else SCORES))
     if args.tiny and scores.resolve() == pathlib.Path(SCORES).resolve():
         p.error(f"--tiny scores are checks: give --scores another folder than the study's {SCORES}")
+    warm = pathlib.Path(args.warm_starts or (pathlib.Path(args.root) / "warm-starts" if args.tiny else WARM_STARTS))
+    if args.tiny and warm.resolve() == WARM_STARTS.resolve():
+        p.error(f"--tiny runs are checks: give --warm-starts another folder than the study's {WARM_STARTS}")
     try:
         study = Study(pathlib.Path(args.root), scores, scenes,
                       {s: args.seeds or DEFAULT_SEEDS[s] for s in scenes},
                       args.images, {s: args.curve if args.curve is not None else DEFAULT_CURVE[s] for s in scenes},
-                      args.tune_images, args.cooldown, args.limit, args.tiny, methods, args.workers,
-                      None if args.tiny else WARM_STARTS)
+                      args.tune_images, args.cooldown, args.limit, args.tiny, methods, args.workers, warm)
     except ValueError as exc:
         p.error(str(exc))
     if args.plan:
         print(plan_text(study))
         return
     if args.save_in_progress:
-        if study.warm_starts is None:
-            p.error("--tiny runs are checks, not kept: --save-in-progress keeps the study's runs")
         kept = save_in_progress(study)
-        print(f"[study] {len(kept)} run(s) in progress kept in {WARM_STARTS}: commit it (git add {WARM_STARTS})"
-              if kept else "[study] no run in progress to keep")
+        print(f"[study] {len(kept)} run(s) in progress kept in {warm}" + ("" if args.tiny else
+              f": commit it (git add {warm})") if kept else "[study] no run in progress to keep")
         return
     enable_compilation_cache()
     if not args.report:

@@ -6,15 +6,19 @@
 #       bash experiments/gpu_run.sh
 #
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
-# later if anything still runs) in runs/study, going on from the committed tuning and scores
-# (experiments/study_scores, in the working tree that travels), then packs what it finished into OUT: log.txt,
-# scores.tgz (the tuning and scores, and the report) and every method's model at the budget IMAGES, models.tgz.*
-# (15 MB parts). Back on the CPU machine:
+# later if anything still runs) in runs/study, going on from the committed tuning, scores and trunks in progress
+# (experiments/study_scores, experiments/warm_starts/study: in the working tree that travels), then packs into OUT:
+# log.txt, scores.tgz (the tuning and scores, and the report), every method's model at the budget IMAGES,
+# models.tgz.*, and the trunks it left unfinished (--save-in-progress: each one's newest checkpoint and the exports
+# its cool-downs still need), warm_starts.tgz.* (15 MB parts). Back on the CPU machine:
 #
 #   tar xzf scores.tgz && cat models.tgz.* | tar xzf - -C runs/study      # then commit experiments/study_scores
+#   cat warm_starts.tgz.* | tar xzf -                                     # experiments/warm_starts/study
 #
-# and the CPU study (python -m experiments.equal_budget) skips what the GPU finished. TINY=1: the tiny check
-# (tiny networks, 48x64 frames, a few images) in its own root and scores, runs/study-tiny, to test it on a CPU.
+# and the CPU study (python -m experiments.equal_budget) skips what the GPU finished and goes on from its unfinished
+# trunks where runs/study has no workdir of that trunk (remove the CPU's own, the study stopped, where the GPU's
+# checkpoint is further). TINY=1: the tiny check (tiny networks, 48x64 frames, a few images) in its own root,
+# scores and warm starts, runs/study-tiny, to test it on a CPU.
 set -u
 T0=$(date +%s)
 : "${OUT:?OUT=output folder}"
@@ -24,10 +28,12 @@ WORKERS=${WORKERS:-14}
 IMAGES=${IMAGES:-30000}
 ROOT=runs/study
 SCORES=experiments/study_scores
+WARM=experiments/warm_starts/study
 ARGS="${STUDY_ARGS:-}"
 if [ -n "${TINY:-}" ]; then
   ROOT=runs/study-tiny
   SCORES=$ROOT/scores
+  WARM=$ROOT/warm-starts
   IMAGES=96
   ARGS="--tiny --curve 48,96 --tune-images 32 --cooldown 0.5 --limit 2 --methods ma2018,lip-cnn,lip-ad $ARGS"
 fi
@@ -36,12 +42,13 @@ mkdir -p "$OUT" "$ROOT"
 . "$(dirname "$0")/gpu_env.sh"
 LEFT=$(( BUDGET_S - ($(date +%s) - T0) - RESERVE_S ))
 echo "== the study for $LEFT s: $ARGS" >> "$LOG"
-timeout -s TERM -k 30 "$LEFT" python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" \
-  --results "$ROOT/report" --workers "$WORKERS" --images "$IMAGES" --no-progress $ARGS >> "$LOG" 2>&1
+STUDY="python3 -m experiments.equal_budget --root $ROOT --scores $SCORES --warm-starts $WARM --images $IMAGES"
+timeout -s TERM -k 30 "$LEFT" $STUDY --results "$ROOT/report" --workers "$WORKERS" --no-progress $ARGS >> "$LOG" 2>&1
 echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
-python3 -m experiments.equal_budget --root "$ROOT" --scores "$SCORES" --results "$ROOT/report" --report \
-  --images "$IMAGES" $ARGS >> "$LOG" 2>&1
+$STUDY --results "$ROOT/report" --report $ARGS >> "$LOG" 2>&1
+$STUDY --save-in-progress $ARGS >> "$LOG" 2>&1
 tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
 (cd "$ROOT" && ls -d */*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
   | split -b 15M - "$OUT/models.tgz.")
+[ -d "$WARM" ] && tar czf - "$WARM" | split -b 15M - "$OUT/warm_starts.tgz."
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

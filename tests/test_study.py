@@ -178,14 +178,20 @@ def test_a_cool_down_made_another_way_is_made_again(tmp_path):
     assert equal_budget.stale_cooldown(config, workdir) is None
 
 
-def test_tiny_checks_keep_their_scores_in_their_root_never_in_the_committed_ones(tmp_path, monkeypatch):
+def test_tiny_checks_keep_their_scores_and_runs_in_progress_in_their_root_never_in_the_committed_ones(tmp_path,
+                                                                                                    monkeypatch):
     monkeypatch.chdir(tmp_path)
-    with pytest.raises(SystemExit):
-        equal_budget.main(["--tiny", "--plan", "--scores", equal_budget.SCORES])
-    seen = {}
-    monkeypatch.setattr(equal_budget, "plan_text", lambda s: seen.setdefault("scores", s.scores) and "")
+    for folder in (["--scores", equal_budget.SCORES], ["--warm-starts", str(equal_budget.WARM_STARTS)]):
+        with pytest.raises(SystemExit):
+            equal_budget.main(["--tiny", "--plan", *folder])
+    seen = []
+    monkeypatch.setattr(equal_budget, "plan_text", lambda s: seen.append((s.scores, s.warm_starts)) or "")
+    monkeypatch.setattr(equal_budget, "save_in_progress", lambda s: seen.append((s.scores, s.warm_starts)) or [])
     equal_budget.main(["--tiny", "--plan", "--root", "check"])
-    assert seen["scores"] == pathlib.Path("check") / "scores"
+    equal_budget.main(["--tiny", "--save-in-progress", "--root", "check"])
+    assert seen == [(pathlib.Path("check") / "scores", pathlib.Path("check") / "warm-starts")] * 2
+    equal_budget.main(["--plan"])
+    assert seen[-1] == (pathlib.Path(equal_budget.SCORES), equal_budget.WARM_STARTS)
 
 
 def test_a_tiny_check_reports_into_its_root_never_into_the_committed_results(tmp_path, monkeypatch):
