@@ -8,12 +8,12 @@
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
 # later if anything still runs) in runs/study, going on from the committed tuning, scores and trunks in progress
 # (experiments/study_scores, experiments/warm_starts/study: in the working tree that travels), then packs into OUT:
-# log.txt, scores.tgz (the tuning and scores, and the report), every method's model at the budget IMAGES,
-# models.tgz.*, and the trunks it left unfinished (--save-in-progress: each one's newest checkpoint and the exports
-# its cool-downs still need), warm_starts.tgz.* (15 MB parts). Back on the CPU machine:
+# log.txt, scores.tgz (the tuning and scores, and the report) and models.tgz.* (15 MB parts, at most 4 for the
+# device tool's 8 files and 64 MB): every method's model at the budget IMAGES, and what this call wrote of the trunks
+# it left unfinished (--save-in-progress: each one's newest checkpoint and the exports its cool-downs still need).
+# Back on the CPU machine, in the repository root:
 #
-#   tar xzf scores.tgz && cat models.tgz.* | tar xzf - -C runs/study      # then commit experiments/study_scores
-#   cat warm_starts.tgz.* | tar xzf -                                     # experiments/warm_starts/study
+#   tar xzf scores.tgz && cat models.tgz.* | tar xzf -     # then commit experiments/study_scores
 #
 # and the CPU study (python -m experiments.equal_budget) skips what the GPU finished and goes on from its unfinished
 # trunks where runs/study has no workdir of that trunk (remove the CPU's own, the study stopped, where the GPU's
@@ -21,6 +21,7 @@
 # scores and warm starts, runs/study-tiny, to test it on a CPU.
 set -u
 T0=$(date +%s)
+STAMP=$(mktemp)  # what the call writes is newer
 : "${OUT:?OUT=output folder}"
 BUDGET_S=${BUDGET_S:-560}
 RESERVE_S=${RESERVE_S:-60}
@@ -48,7 +49,6 @@ echo "== the study ended ($?) at $(( $(date +%s) - T0 )) s" >> "$LOG"
 $STUDY --results "$ROOT/report" --report $ARGS >> "$LOG" 2>&1
 $STUDY --save-in-progress $ARGS >> "$LOG" 2>&1
 tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
-(cd "$ROOT" && ls -d */*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null | tar czf - -T - \
-  | split -b 15M - "$OUT/models.tgz.")
-[ -d "$WARM" ] && tar czf - "$WARM" | split -b 15M - "$OUT/warm_starts.tgz."
+{ ls -d "$ROOT"/*/*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null; find "$WARM" -type f -newer "$STAMP" 2>/dev/null; } \
+  | tar czf - -T - | split -b 15M - "$OUT/models.tgz."
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"
