@@ -8,9 +8,10 @@
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
 # later if anything still runs) in runs/study, going on from the committed tuning, scores and trunks in progress
 # (experiments/study_scores, experiments/warm_starts/study: in the working tree that travels), then packs into OUT:
-# log.txt, scores.tgz (the tuning and scores, and the report) and models.tgz.* (15 MB parts, at most 4 for the
-# device tool's 8 files and 64 MB): every method's model at the budget IMAGES, and what this call wrote of the trunks
-# it left unfinished (--save-in-progress: each one's newest checkpoint and the exports its cool-downs still need).
+# log.txt, scores.tgz (the tuning and scores, and the report) and models.tgz.* (15 MB parts; the device tool brings
+# back 8 files and 64 MB at most, so give a call no more work than 4 parts hold: a trunk's checkpoint is ~17 MB):
+# every method's model at the budget IMAGES, and what this call wrote of the trunks it left unfinished
+# (--save-in-progress: each one's newest checkpoint and the exports its cool-downs still need).
 # Back on the CPU machine, in the repository root:
 #
 #   tar xzf scores.tgz && cat models.tgz.* | tar xzf -     # then commit experiments/study_scores
