@@ -249,7 +249,7 @@ def test_trains_a_few_steps_and_resumes(tmp_path, source):
     assert all(np.isfinite(r["loss"]) for r in rows if "loss" in r)
     assert [r for r in rows if r.get("split") == "val"][0]["rmse_m"] > 0
     _, meta = CheckpointManager(tmp_path / "run" / "checkpoints").restore(init_state(config))
-    assert meta["data_loader"]["next_step"] == 3
+    assert meta["data_position"] == 3
     straight = loop.train(config, tmp_path / "straight", progress=False)  # the same 3 steps without the stop
     for a, b in zip(jax.tree_util.tree_leaves(straight.g_params), jax.tree_util.tree_leaves(state.g_params),
                     strict=True):

@@ -408,7 +408,7 @@ def test_sigterm_saves_the_step_and_stops_the_loader_workers_with_the_run(tmp_pa
     manager = CheckpointManager(tmp_path / "run" / "checkpoints")
     state, meta = manager.restore(init_state(get_config("smoke")))  # what a resumed run starts from
     manager.close()
-    assert int(state.step) == meta["data_position"] == saved[0] and meta["data_loader"]["next_step"] == saved[0]
+    assert int(state.step) == meta["data_position"] == saved[0]
 
 
 @pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
@@ -422,6 +422,19 @@ def test_sigterm_while_the_loader_workers_start_stops_the_run_as_asked(tmp_path)
     assert logged == [] and saved == [], (logged, saved)
     assert "[lipjax] SIGTERM: a data loader worker ended with it before step 0; stopping" in text, text[-3000:]
     assert "Traceback" not in text and "leaked shared_memory" not in text, text[-3000:]
+    assert _workers_end(workers), "loader workers outlived the run"
+
+
+@pytest.mark.skipif(not pathlib.Path("/proc/self/stat").exists(), reason="needs Linux /proc")
+def test_sigterm_while_a_resumed_runs_loader_workers_start_stops_it_too(tmp_path):
+    """The same for a resumed run, whose loader starts at its step (a grain iterator state restored into it
+    waited forever for the acknowledgement of a worker that had died)."""
+    status, _, logged, saved, _ = _signal_a_smoke_run(tmp_path, signal.SIGTERM, group=True)
+    assert status == 143 and saved == [logged[-1]], (logged, saved)
+    status, workers, _, _, text = _signal_a_smoke_run(tmp_path, signal.SIGTERM, group=True, at_worker_start=True)
+    assert status == 143, text[-3000:]
+    assert f"resumed smoke from step {saved[0]}" in text, text[-3000:]
+    assert f"a data loader worker ended with it before step {saved[0]}; stopping" in text, text[-3000:]
     assert _workers_end(workers), "loader workers outlived the run"
 
 

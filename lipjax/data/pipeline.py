@@ -270,14 +270,15 @@ class TrainLoader:
 
     Args:
       steps: a StepBatches.
-      first_step: the step the grain data set starts at (a run's start, or the restored state's).
+      first_step: the first step it loads (a run's start, or the step a checkpoint resumes at).
       num_workers: worker processes (0: one background thread in this process).
-      state: a `state()` saved by an earlier loader with the same first_step and num_workers (resume).
-    Iterating yields Batch; each element's step is checked against the expected one, so a state restored into
-    a different setup fails loudly instead of training on the wrong batches.
+    Batch s is a function of s alone (StepBatches), so a resumed run starts a new loader at its step: no grain
+    iterator state is saved or restored (grain 0.2.18, given a state, waits forever for its worker's
+    acknowledgement when that worker died starting). Iterating yields Batch; each element's step is checked against
+    the expected one, so a loader that went wrong fails loudly instead of training on the wrong batches.
     """
 
-    def __init__(self, steps: StepBatches, first_step: int = 0, num_workers: int = 0, state: dict | None = None):
+    def __init__(self, steps: StepBatches, first_step: int = 0, num_workers: int = 0):
         grain = _grain()
         self.first_step, self.num_workers = first_step, num_workers
         dataset = grain.MapDataset.source(steps)[first_step:].to_iter_dataset(
@@ -287,14 +288,7 @@ class TrainLoader:
                                                                        per_worker_buffer_size=WORKER_BUFFER),
                                           worker_init_fn=_single_threaded_worker)
         self._iterator = iter(dataset)
-        if state is not None:
-            self._iterator.set_state(state["grain"])
-        self.next_step = first_step if state is None else int(state["next_step"])
-
-    def state(self) -> dict:
-        """JSON-serialisable position (grain iterator state, next step, first step, worker count)."""
-        return {"grain": self._iterator.get_state(), "next_step": self.next_step, "first_step": self.first_step,
-                "num_workers": self.num_workers}
+        self.next_step = first_step
 
     def __iter__(self) -> "TrainLoader":
         return self
@@ -303,8 +297,7 @@ class TrainLoader:
         arrays = dict(next(self._iterator))
         step = int(arrays.pop("step"))
         if step != self.next_step:
-            raise RuntimeError(f"the data loader yielded step {step}, expected {self.next_step}; "
-                               "remove the checkpoint's data_loader state or start a new workdir")
+            raise RuntimeError(f"the data loader yielded step {step}, expected {self.next_step}")
         self.next_step += 1
         # Copied out of the workers' shared memory at once, so that grain unlinks it now, while the loader runs:
         # a batch still in hand when a signal stops the run would leak its segments ("leaked shared_memory").

@@ -155,30 +155,25 @@ def _next_batch(loader: TrainLoader, stop: _Stop, step: int) -> Batch:
         raise SystemExit(128 + stop.signum) from None
 
 
-def _resume(config: TrainConfig, manager: CheckpointManager, is_main: bool) -> tuple[TrainState, dict]:
-    """(state, checkpoint metadata): the latest checkpoint's, else a fresh state ({} metadata)."""
+def _resume(config: TrainConfig, manager: CheckpointManager, is_main: bool) -> TrainState:
+    """The latest checkpoint's state, else a fresh one."""
     state = init_state(config, _initial_g_params(config))
-    meta: dict = {}
     if manager.latest_step() is not None:
         state, meta = manager.restore(state)
         if meta.get("data_position") != int(state.step):
             raise RuntimeError(f"checkpoint data position {meta.get('data_position')} != step {int(state.step)}")
         if is_main:
             print(f"[lipjax] resumed {config.name} from step {int(state.step)} in {manager.directory}")
-    return state, meta
+    return state
 
 
-def _train_loader(config: TrainConfig, start: int, meta: dict, process_index: int, process_count: int) -> TrainLoader:
-    """This process's batches of every step from `start`, restoring the loader state a checkpoint saved."""
+def _train_loader(config: TrainConfig, start: int, process_index: int, process_count: int) -> TrainLoader:
+    """This process's batches of every step from `start` (a resumed run's too: batch s depends on s alone)."""
     d = config.data
     source = open_source(d, "train")
     local = BatchIterator(source.dataset, config.batch_size, source.sampler, seed=config.seed,
                           process_index=process_index, process_count=process_count)
     step_batches = StepBatches(local, config.total_steps, d.augment, d.crop, config.seed, config.model)
-    saved = meta.get("data_loader")
-    if saved is not None and saved["num_workers"] == d.num_workers and saved["next_step"] == start:
-        return TrainLoader(step_batches, saved["first_step"], d.num_workers, state=saved)
-    # no saved loader state (an older checkpoint) or another worker count: same batches from the step
     return TrainLoader(step_batches, start, d.num_workers)
 
 
@@ -263,13 +258,13 @@ def train(
             raise
     (workdir / "config.txt").write_text(repr(config) + "\n")
     (workdir / RUN_FILE).write_text(json.dumps(run_record(config)) + "\n")
-    state, meta = _resume(config, manager, is_main)
+    state = _resume(config, manager, is_main)
     start = int(state.step)
     rng = jax.random.wrap_key_data(np.asarray(state.rng))
     state = jax.device_put(state, NamedSharding(mesh, PartitionSpec()))  # replicated
     steps = make_steps(config)
     end = config.total_steps if stop_at is None else min(stop_at, config.total_steps)
-    loader = _train_loader(config, start, meta, process_index, process_count)
+    loader = _train_loader(config, start, process_index, process_count)
     shown = _Progress(config, workdir, start, end, progress, is_main)
     step = start
     if val and validate_start and start == 0:
@@ -288,8 +283,7 @@ def train(
                 if done % config.log_every == 0 or done == end:
                     shown.train_step(done, phase, metrics, manager)
                 if done % config.checkpoint_every == 0 or done == end or stop.is_set():
-                    manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name,
-                                               "data_loader": loader.state()})
+                    manager.save(done, state, {"data_position": done, "phase": phase, "name": config.name})
                 if stop.is_set() and done < end:
                     shown.bar.write(f"[lipjax] {signal.Signals(stop.signum).name}: saved step {done} in "
                                     f"{manager.directory}; stopping (run again to resume)")
