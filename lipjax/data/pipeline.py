@@ -13,8 +13,8 @@ epoch (`redraw_each_epoch`: `redraw_seed`), still a pure function of (seed, s).
 
 Workers. `TrainLoader` runs the whole per-step work (reading, sampling, augmentation and crop, the host z0
 fill) in `num_workers` grain worker processes (grain.IterDataset.mp_prefetch): element s of its grain
-MapDataset is this process's batch of step s, so the worker count changes the speed, never the batches.
-Its state (grain's iterator state) is saved in each checkpoint's metadata and restored on resume.
+MapDataset is this process's batch of step s, so the worker count changes the speed, never the batches, and a
+resumed run's loader starts at its step.
 
 Multi-host. Every process builds the same BatchIterator (same seed, same global batch_size) with its own
 process_index / process_count = jax.process_index() / jax.process_count(); it loads only its contiguous

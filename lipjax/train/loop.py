@@ -6,8 +6,8 @@ Layout of `workdir`: checkpoints/<step>/ (orbax), metrics.jsonl (one JSON object
 config.txt (the config's repr) and run.json (`run_record`, which a resume and an export of the workdir check). A
 run writes nothing outside its workdir. Resume is exact: the state holds parameters, both optimiser states, the
 step and the RNG key; the data position is the step (batch s is a pure function of (seed, s), see
-lipjax.data.pipeline), recorded in each checkpoint's metadata with the loader's grain iterator state, and checked
-on resume.
+lipjax.data.pipeline), recorded in each checkpoint's metadata, checked on resume, and where a resumed run's loader
+starts.
 """
 from __future__ import annotations
 
