@@ -578,8 +578,9 @@ def main(argv=None) -> None:
         return
     if args.save_in_progress:
         kept = save_in_progress(study)
-        print(f"[study] {len(kept)} run(s) in progress kept in {warm}" + ("" if args.tiny else
-              f": commit it (git add {warm})") if kept else "[study] no run in progress to keep")
+        commit = "" if args.tiny else f": commit it (git add {warm})"
+        print(f"[study] {len(kept)} run(s) in progress kept in {warm}{commit}" if kept
+              else "[study] no run in progress to keep")
         return
     enable_compilation_cache()
     if not args.report:

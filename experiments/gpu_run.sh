@@ -52,4 +52,5 @@ $STUDY --save-in-progress $ARGS >> "$LOG" 2>&1
 tar czf "$OUT/scores.tgz" "$SCORES" "$ROOT/report"
 { ls -d "$ROOT"/*/*/lr*/seed*/"$IMAGES"/model.* 2>/dev/null; find "$WARM" -type f -newer "$STAMP" 2>/dev/null; } \
   | tar czf - -T - | split -b 15M - "$OUT/models.tgz."
+rm -f "$STAMP"
 echo "== done at $(( $(date +%s) - T0 )) s" >> "$LOG"

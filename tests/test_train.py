@@ -366,13 +366,14 @@ def _signal_a_smoke_run(tmp_path: pathlib.Path, signum: int, group: bool,
                                 start_new_session=True)
     metrics = workdir / "metrics.jsonl"
     try:
+        def ready() -> bool:
+            if at_worker_start:
+                return bool(_loader_workers(proc.pid))
+            return metrics.exists() and metrics.read_text().count("\n") >= 2
+
         deadline = time.time() + 240
-        if at_worker_start:
-            while not _loader_workers(proc.pid) and time.time() < deadline:
-                time.sleep(0.01)
-        while not at_worker_start and not (metrics.exists() and metrics.read_text().count("\n") >= 2) \
-                and time.time() < deadline:
-            time.sleep(0.2)
+        while not ready() and time.time() < deadline:
+            time.sleep(0.01)
         workers = children(proc.pid)
         assert workers, "the run should have a loader worker process"
         os.killpg(proc.pid, signum) if group else proc.send_signal(signum)

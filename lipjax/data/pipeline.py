@@ -280,7 +280,6 @@ class TrainLoader:
 
     def __init__(self, steps: StepBatches, first_step: int = 0, num_workers: int = 0):
         grain = _grain()
-        self.first_step, self.num_workers = first_step, num_workers
         dataset = grain.MapDataset.source(steps)[first_step:].to_iter_dataset(
             grain.ReadOptions(num_threads=1, prefetch_buffer_size=WORKER_BUFFER))
         if num_workers > 0:
