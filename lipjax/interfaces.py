@@ -14,7 +14,7 @@ Depth ranges: each meaning of "max depth" has one home.
 from __future__ import annotations
 
 import abc
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import jax
 import numpy as np
@@ -76,9 +76,6 @@ class LearnedModel(abc.ABC):
     *, return_trajectory=False, **host_inputs) -> (depth (B, H, W) metres, trajectory or None). `host_inputs`
     are the arrays `host_inputs(sparse)` computes outside the compiled program (e.g. the LIP model's z0).
     """
-
-    # Iterative models (the unrolled LIP solver) have `num_iterations` and per-iteration trajectories.
-    iterative: ClassVar[bool] = False
 
     @abc.abstractmethod
     def init(self, key: jax.Array) -> Params:

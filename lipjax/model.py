@@ -75,8 +75,6 @@ class LIPConfig(LearnedModel):
     guidance: Guidance = "rgb+mask"
     output: Output = "x"
 
-    iterative = True  # lipjax.interfaces.LearnedModel: num_iterations, trajectories
-
     def init(self, key: jax.Array) -> "Params":
         """Random parameters for this config from a jax.random key (module function `init`): the pytree of the
         module docstring; their shapes do not depend on the image size."""

@@ -15,8 +15,10 @@ def test_every_model_type_is_a_learned_model_and_named_both_ways():
     for name, cls in MODEL_TYPES.items():
         assert issubclass(cls, LearnedModel)
         assert model_type_name(cls) == name
-    assert LIPConfig.iterative and not any(MODEL_TYPES[n].iterative for n in PRESETS)
     assert LIPConfig().host_input_names == ()  # box fill: computed inside the program
+    for name in PRESETS:  # only the unrolled solver has an iteration count to choose
+        with pytest.raises(ValueError, match="end-to-end network: it has no iterations"):
+            baseline_preset(name, "tiny").with_iterations({}, 5)
     assert dataclasses.replace(LIPConfig(), initial_estimate="linear").host_input_names == ("z0",)
 
 
