@@ -2,9 +2,11 @@
 
 Writes into the results folder (docs/results by default):
   equal_budget.json   {"indoor": {"<method>": {"images", "seeds", "rmse_m", "mae_m"}, "linear": {...},
-                       "nearest": {...}}, "outdoor": {...}, "details": {tuning, curve, iterations, paired tests}}
+                       "nearest": {...}}, "outdoor": {...}, "details": {tuning, curve, iterations, paired tests,
+                       larger_budgets: {N: the same summary and tests at each larger budget all methods reached}}}
   equal_budget.md     per scene, mean +- standard deviation over seeds at the budget, the methods still falling
-                      steeply at the end of their curve (STEEP_CHANGE), and the paired tests
+                      steeply at the end of their curve (STEEP_CHANGE), and the paired tests; then the same again
+                      at each larger budget of the curve that every method has reached (seed 0 at 100,000)
   equal_budget_curve.png        test RMSE against training images (the data-efficiency curve), rooms
   equal_budget_iterations.png   test RMSE against the ADMM iteration count K of the LIP runs (Fig. 4a)
 
@@ -114,6 +116,23 @@ def verdict(test: dict) -> str:
     if low > 0 and test["b_better_seeds"] == len(test["seeds"]):
         return f"{test['b']} leads"
     return "not separated"
+
+
+def compare(scores: list[dict], classical: dict, images: int) -> tuple[dict, list[dict]]:
+    """(the scene_summary at `images`, the PAIRS' paired tests there)."""
+    summary = scene_summary(scores, classical, images)
+    best = best_end_to_end(summary)
+    tests = [paired_test(scores, a, best if b == "best end-to-end" else b, images)
+             for a, b in PAIRS if (best or b != "best end-to-end")]
+    return summary, [t for t in tests if t]
+
+
+def larger_budgets(scores: list[dict], images: int) -> list[int]:
+    """The budgets above `images` that every method scored at `images` has reached (seed 0's curve, decision 0028):
+    where the study compares its methods again, at the curve's end, once all of them are there."""
+    methods = {s["method"] for s in scores if s["images"] == images}
+    later = {s["images"] for s in scores if s["images"] > images}
+    return sorted(n for n in later if methods and methods <= {s["method"] for s in scores if s["images"] == n})
 
 
 def best_end_to_end(summary: dict) -> str | None:
@@ -226,18 +245,40 @@ def markdown(doc: dict, images: int) -> str:
             lines += ["", f"Still falling steeply at the end of its curve (RMSE more than {-STEEP_CHANGE:.0%} below "
                       f"the budget before, decision 0028): {falling or 'none'}."]
         lines += tuning_table(doc["details"][scene]["tuning_val_rmse_m"])
-        tests = doc["details"][scene]["paired_tests"]
-        if tests:
-            lines += ["", "| paired test a vs b | seeds | frames | mean RMSE a / b m | a better on frames | "
-                      "Wilcoxon p | t-test p | a better on seeds | a - b m, 95 % over seeds and frames | verdict |",
-                      "|---|---|---:|---:|---:|---:|---:|---:|---|---|"]
-            lines += [f"| {t['a']} vs {t['b']} | {','.join(map(str, t['seeds']))} | {t['frames']} | "
-                      f"{t['mean_rmse_a_m']:.4f} / {t['mean_rmse_b_m']:.4f} | {t['a_better_frames']} | "
-                      f"{t['wilcoxon_p']:.2g} | {t['ttest_p']:.2g} | {t['a_better_seeds']} of {len(t['seeds'])} | "
-                      f"{t['diff_interval_m'][0]:+.4f} to {t['diff_interval_m'][1]:+.4f} | {t['verdict']} |"
-                      for t in tests]
+        lines += _paired_table(doc["details"][scene]["paired_tests"])
+        for n, at in doc["details"][scene]["larger_budgets"].items():
+            lines += _larger_budget_section(int(n), at["summary"], at["paired_tests"])
         lines.append("")
     return "\n".join(lines)
+
+
+def _paired_table(tests: list[dict]) -> list[str]:
+    if not tests:
+        return []
+    return ["", "| paired test a vs b | seeds | frames | mean RMSE a / b m | a better on frames | Wilcoxon p | "
+            "t-test p | a better on seeds | a - b m, 95 % over seeds and frames | verdict |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---|---|"] + [
+        f"| {t['a']} vs {t['b']} | {','.join(map(str, t['seeds']))} | {t['frames']} | "
+        f"{t['mean_rmse_a_m']:.4f} / {t['mean_rmse_b_m']:.4f} | {t['a_better_frames']} | "
+        f"{t['wilcoxon_p']:.2g} | {t['ttest_p']:.2g} | {t['a_better_seeds']} of {len(t['seeds'])} | "
+        f"{t['diff_interval_m'][0]:+.4f} to {t['diff_interval_m'][1]:+.4f} | {t['verdict']} |" for t in tests]
+
+
+def _larger_budget_section(images: int, summary: dict, tests: list[dict]) -> list[str]:
+    """Every method again at a larger budget of the curve (larger_budgets), with its paired tests."""
+    linear = summary.get("linear", {}).get("rmse_m")
+    seeds = sorted({k for row in summary.values() for k in row.get("seeds", ())})
+    lines = ["", f"### Every method at {images:,} images (seed{'s' * (len(seeds) != 1)} "
+             f"{','.join(map(str, seeds))}; the curve's end)", "",
+             "| method | seeds | RMSE m | MAE m | RMSE / linear |", "|---|---|---:|---:|---:|"]
+    for method, row in summary.items():
+        ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
+        if "seeds" in row:
+            lines.append(f"| {method} | {','.join(map(str, row['seeds']))} | {_mean_std(row['rmse_m'])} | "
+                         f"{_mean_std(row['mae_m'])} | {ratio} |")
+        else:
+            lines.append(f"| {method} (no training) | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | {ratio} |")
+    return lines + _paired_table(tests)
 
 
 def best_rate(rmse: dict[float, float]) -> float:
@@ -343,17 +384,15 @@ def write_report(study, scores_left: list[str], keep, out: pathlib.Path | None =
         classical = json.loads(classical_path.read_text()) if classical_path.exists() else {}
         if not scores:
             continue
-        summary = scene_summary(scores, classical, study.images)
-        doc[scene] = summary
-        best = best_end_to_end(summary)
-        tests = [paired_test(scores, a, best if b == "best end-to-end" else b, study.images)
-                 for a, b in PAIRS if (best or b != "best end-to-end")]
+        doc[scene], tests = compare(scores, classical, study.images)
         tuning_path = study.scores_dir(scene) / "tuning.json"
         doc["details"][scene] = {
             "tuning_val_rmse_m": json.loads(tuning_path.read_text()) if tuning_path.exists() else {},
             "curve_rmse_m": curve(scores), "curve_change": curve_change(scores),
             "rmse_m_by_iterations": iterations(scores, study.images),
-            "paired_tests": [t for t in tests if t], "test_frames": len(scores[0]["per_image"]),
+            "paired_tests": tests, "test_frames": len(scores[0]["per_image"]),
+            "larger_budgets": {str(n): dict(zip(("summary", "paired_tests"), compare(scores, classical, n)))
+                               for n in larger_budgets(scores, study.images)},
         }
         names = {"indoor": "rooms, 200 points (Table I)", "outdoor": "streets, 64 beams (Table II)"}
         plot_curve(out / f"equal_budget_curve_{scene}.png", doc["details"][scene]["curve_rmse_m"], classical,

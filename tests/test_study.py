@@ -309,6 +309,44 @@ def test_paired_test_matches_scipy_over_frames_averaged_over_the_seeds():
         study_report.paired_test(a + b, "lip-ad", "unet", 32)
 
 
+def test_the_report_compares_every_method_again_at_each_larger_budget_all_of_them_reached(tmp_path):
+    """Seed 0's curve goes on past the table's budget B = 64: once every method has its 128-image score the report
+    holds that table and its paired tests again (the best end-to-end network chosen there); 256, which only U-Net
+    has reached, waits."""
+    s = study(tmp_path)
+    rng = np.random.default_rng(2)
+    offsets = {"lip-ad": 0.0, "lip-cnn": 0.01, "unet": 0.02, "cspn": 0.03}  # at B U-Net is the best end-to-end net
+    runs = [(m, k, 64, off) for m, off in offsets.items() for k in (0, 1)]
+    runs += [(m, 0, 128, off - 0.05 if m == "cspn" else off) for m, off in offsets.items()]  # CSPN best at 128
+    runs += [("unet", 0, 256, 0.0)]
+    folder = s.scores / "indoor"
+    folder.mkdir(parents=True)
+    frames = rng.uniform(0.2, 0.3, 8)  # each frame's difficulty, shared; the offsets rank the methods
+    for method, seed, images, offset in runs:
+        values = frames + offset + rng.normal(0.0, 0.002, 8)
+        per_image = [{"id": f"f{i}", "rmse_m": float(v)} for i, v in enumerate(values)]
+        rmse = float(np.mean([p["rmse_m"] for p in per_image]))
+        (folder / f"{method}-seed{seed}-{images}.json").write_text(json.dumps(
+            {"method": method, "seed": seed, "images": images, "rmse_m": rmse, "mae_m": rmse / 2,
+             "per_image": per_image}))
+    scores = study_report.load_scores(s.scores, "indoor")
+    assert study_report.larger_budgets(scores, 64) == [128]
+    assert study_report.larger_budgets(scores, 128) == []  # only U-Net at 256
+    doc = study_report.write_report(s, [], lambda score: True, out=tmp_path / "report")
+    assert doc["indoor"]["unet"]["seeds"] == [0, 1] and list(doc["details"]["indoor"]["larger_budgets"]) == ["128"]
+    at = doc["details"]["indoor"]["larger_budgets"]["128"]
+    assert at["summary"]["cspn"] == {"images": 128, "seeds": [0], "rmse_m": [pytest.approx(
+        json.loads((folder / "cspn-seed0-128.json").read_text())["rmse_m"])], "mae_m": [pytest.approx(
+            json.loads((folder / "cspn-seed0-128.json").read_text())["mae_m"])]}
+    assert [(t["a"], t["b"]) for t in doc["details"]["indoor"]["paired_tests"]] == [("lip-ad", "unet"),
+                                                                                    ("lip-ad", "lip-cnn")]
+    assert [(t["a"], t["b"]) for t in at["paired_tests"]] == [("lip-ad", "cspn"), ("lip-ad", "lip-cnn")]
+    assert at["paired_tests"][0] == study_report.paired_test(scores, "lip-ad", "cspn", 128)
+    md = (tmp_path / "report" / "equal_budget.md").read_text()
+    section = md.split("### Every method at 128 images (seed 0; the curve's end)")[1]
+    assert "| cspn | 0 | " in section and "| lip-ad vs cspn | 0 | 8 | " in section and "256" not in section
+
+
 def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
     points = {(0, 10_000): 0.30, (0, 30_000): 0.24, (0, 100_000): 0.216, (1, 10_000): 0.20, (1, 30_000): 0.18,
               (2, 10_000): 0.50}  # seed 2 not yet at 30,000: it must not pull the 10,000 -> 30,000 step
