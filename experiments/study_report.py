@@ -272,12 +272,13 @@ def _larger_budget_section(images: int, summary: dict, tests: list[dict]) -> lis
              f"{','.join(map(str, seeds))}; the curve's end)", "",
              "| method | seeds | RMSE m | MAE m | RMSE / linear |", "|---|---|---:|---:|---:|"]
     for method, row in summary.items():
-        ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
         if "seeds" in row:
+            ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
             lines.append(f"| {method} | {','.join(map(str, row['seeds']))} | {_mean_std(row['rmse_m'])} | "
                          f"{_mean_std(row['mae_m'])} | {ratio} |")
         else:
-            lines.append(f"| {method} (no training) | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | {ratio} |")
+            lines.append(f"| {method} (no training) | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
+                         f"{row['rmse_m'] / linear:.2f}x |")
     return lines + _paired_table(tests)
 
 

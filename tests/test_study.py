@@ -329,22 +329,26 @@ def test_the_report_compares_every_method_again_at_each_larger_budget_all_of_the
         (folder / f"{method}-seed{seed}-{images}.json").write_text(json.dumps(
             {"method": method, "seed": seed, "images": images, "rmse_m": rmse, "mae_m": rmse / 2,
              "per_image": per_image}))
+    (folder / "classical.json").write_text(json.dumps({"linear": {"rmse_m": 0.3, "mae_m": 0.1},
+                                                        "nearest": {"rmse_m": 0.4, "mae_m": 0.2}}))
     scores = study_report.load_scores(s.scores, "indoor")
     assert study_report.larger_budgets(scores, 64) == [128]
     assert study_report.larger_budgets(scores, 128) == []  # only U-Net at 256
     doc = study_report.write_report(s, [], lambda score: True, out=tmp_path / "report")
     assert doc["indoor"]["unet"]["seeds"] == [0, 1] and list(doc["details"]["indoor"]["larger_budgets"]) == ["128"]
     at = doc["details"]["indoor"]["larger_budgets"]["128"]
-    assert at["summary"]["cspn"] == {"images": 128, "seeds": [0], "rmse_m": [pytest.approx(
-        json.loads((folder / "cspn-seed0-128.json").read_text())["rmse_m"])], "mae_m": [pytest.approx(
-            json.loads((folder / "cspn-seed0-128.json").read_text())["mae_m"])]}
+    cspn = json.loads((folder / "cspn-seed0-128.json").read_text())
+    assert at["summary"]["cspn"] == {"images": 128, "seeds": [0], "rmse_m": [cspn["rmse_m"]], "mae_m": [cspn["mae_m"]]}
+    assert at["summary"]["linear"] == {"rmse_m": 0.3, "mae_m": 0.1}
     assert [(t["a"], t["b"]) for t in doc["details"]["indoor"]["paired_tests"]] == [("lip-ad", "unet"),
                                                                                     ("lip-ad", "lip-cnn")]
     assert [(t["a"], t["b"]) for t in at["paired_tests"]] == [("lip-ad", "cspn"), ("lip-ad", "lip-cnn")]
     assert at["paired_tests"][0] == study_report.paired_test(scores, "lip-ad", "cspn", 128)
     md = (tmp_path / "report" / "equal_budget.md").read_text()
     section = md.split("### Every method at 128 images (seed 0; the curve's end)")[1]
-    assert "| cspn | 0 | " in section and "| lip-ad vs cspn | 0 | 8 | " in section and "256" not in section
+    assert f"| cspn | 0 | {cspn['rmse_m']:.4f} | {cspn['mae_m']:.4f} | {cspn['rmse_m'] / 0.3:.2f}x |" in section
+    assert "| linear (no training) | | 0.3000 | 0.1000 | 1.00x |" in section
+    assert "| lip-ad vs cspn | 0 | 8 | " in section and "256" not in section
 
 
 def test_the_curves_change_is_taken_over_the_seeds_scored_at_both_budgets():
