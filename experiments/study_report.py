@@ -231,14 +231,11 @@ def markdown(doc: dict, images: int) -> str:
             if "curve only" in row:  # scored on the way, not yet at the budget
                 curve_text = _curve_text(curves[method], changes.get(method, {}))
                 lines.append(f"| {method} | not yet | | | | | {curve_text} |")
-            elif "seeds" in row:
-                ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
-                curve_text = _curve_text(curves.get(method, {}), changes.get(method, {}))
-                lines.append(f"| {method} | {row['images']:,} | {','.join(map(str, row['seeds']))} | "
-                             f"{_mean_std(row['rmse_m'])} | {_mean_std(row['mae_m'])} | {ratio} | {curve_text} |")
             else:
-                lines.append(f"| {method} (no training) | | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
-                             f"{row['rmse_m'] / linear:.2f}x | |")
+                name, seeds, *errors = _summary_cells(method, row, linear)
+                images_text = f"{row['images']:,}" if "images" in row else ""  # a fill: no training
+                curve_text = _curve_text(curves.get(method, {}), changes.get(method, {}))
+                lines.append(_table_row([name, images_text, seeds, *errors, curve_text]))
         if changes:  # a curve of two budgets or more
             falling = ", ".join(f"{m} ({s['from']:,} -> {s['to']:,} images: {s['change']:+.0%})"
                                 for m, s in still_falling(changes).items())
@@ -271,15 +268,23 @@ def _larger_budget_section(images: int, summary: dict, tests: list[dict]) -> lis
     lines = ["", f"### Every method at {images:,} images (seed{'s' * (len(seeds) != 1)} "
              f"{','.join(map(str, seeds))}; the curve's end)", "",
              "| method | seeds | RMSE m | MAE m | RMSE / linear |", "|---|---|---:|---:|---:|"]
-    for method, row in summary.items():
-        if "seeds" in row:
-            ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
-            lines.append(f"| {method} | {','.join(map(str, row['seeds']))} | {_mean_std(row['rmse_m'])} | "
-                         f"{_mean_std(row['mae_m'])} | {ratio} |")
-        else:
-            lines.append(f"| {method} (no training) | | {row['rmse_m']:.4f} | {row['mae_m']:.4f} | "
-                         f"{row['rmse_m'] / linear:.2f}x |")
+    lines += [_table_row(_summary_cells(method, row, linear)) for method, row in summary.items()]
     return lines + _paired_table(tests)
+
+
+def _table_row(cells: list[str]) -> str:
+    """'| a | | b |': a markdown table row, an empty cell as '| |'."""
+    return "|" + "|".join(f" {c} " if c else " " for c in cells) + "|"
+
+
+def _summary_cells(method: str, row: dict, linear: float | None) -> list[str]:
+    """[name, seeds, RMSE m, MAE m, RMSE / linear] of a scene_summary row: a trained method's mean +- std over its
+    seeds, or a fill's (no training) single figures."""
+    if "seeds" not in row:
+        return [f"{method} (no training)", "", f"{row['rmse_m']:.4f}", f"{row['mae_m']:.4f}",
+                f"{row['rmse_m'] / linear:.2f}x"]
+    ratio = f"{statistics.mean(row['rmse_m']) / linear:.2f}x" if linear else ""
+    return [method, ",".join(map(str, row["seeds"])), _mean_std(row["rmse_m"]), _mean_std(row["mae_m"]), ratio]
 
 
 def best_rate(rmse: dict[float, float]) -> float:
