@@ -21,9 +21,10 @@ N is the trunk's at N - C cooled down over C = --cooldown x N more images (the r
 Stages, each skipped when its output exists, so the study continues across sessions and survives any stop (every
 run is a checkpointed training that resumes). The tuning and the scores are small JSON files in --scores
 (experiments/study_scores, committed: a new machine goes on from them); runs, checkpoints and models stay in --root
-(runs/study, not committed) except the trunk runs in progress at a session's end: --save-in-progress copies each
-(its newest checkpoint and the exports still needed) to --warm-starts (experiments/warm_starts/study/<scene>/<trunk>/
-lr<rate>/seed<k>), committed once a session, and a new machine continues from there:
+(runs/study, not committed) except the runs in progress at a session's end: --save-in-progress copies each trunk (its
+newest checkpoint and the exports still needed) and each cool-down (its newest checkpoint) to --warm-starts
+(experiments/warm_starts/study/<scene>/<method>/lr<rate>/seed<k>[/<budget>]), committed once a session, and a new
+machine continues from there:
   1. tuning: each trunk's learning rate, the lowest validation RMSE after --tune-images images among TUNE_LRS and,
      while the best is the grid's edge, rates beyond it (`next_rate`; seed 0, the validation split: never the test
      split); the same small budget for every trunk;
@@ -257,20 +258,44 @@ def drop_stale_scores(study: Study, scene: str, methods: list[str], seed: int, l
 def trunk_workdir(study: Study, scene: str, trunk: str, lr: float, seed: int) -> pathlib.Path:
     """The run's workdir in --root (one per learning rate); on a machine without it, a copy of the one committed
     under study.warm_starts (the run that was in progress when a session ended), if any."""
-    workdir = run_dir(study.root, scene, trunk, lr, seed)
-    committed = None if study.warm_starts is None else run_dir(study.warm_starts, scene, trunk, lr, seed)
+    return _go_on_from_committed(study, run_dir(study.root, scene, trunk, lr, seed), f"{scene} {trunk} seed {seed}")
+
+
+def cooldown_workdir(study: Study, scene: str, method: str, lr: float, seed: int, budget: int) -> pathlib.Path:
+    """The workdir of `method`'s cool-down to `budget` in --root; on a machine without it, a copy of the one
+    committed under study.warm_starts (a cool-down in progress when a session ended), if any."""
+    return _go_on_from_committed(study, run_dir(study.root, scene, method, lr, seed) / str(budget),
+                                 f"{scene} {method} seed {seed} at {budget} images")
+
+
+def _go_on_from_committed(study: Study, workdir: pathlib.Path, name: str) -> pathlib.Path:
+    """`workdir` (under --root), copied first from its committed copy (the same path under study.warm_starts) where
+    --root lacks it and a copy exists."""
+    committed = _committed(study, workdir)
     if not workdir.exists() and committed is not None and committed.is_dir():
         shutil.copytree(committed, workdir)
-        print(f"[study] {scene} {trunk} seed {seed}: continuing from {committed}", flush=True)
+        print(f"[study] {name}: continuing from {committed}", flush=True)
     return workdir
 
 
+def _committed(study: Study, path: pathlib.Path) -> pathlib.Path | None:
+    """Where `path` (under --root) is kept under study.warm_starts; None without warm starts."""
+    return None if study.warm_starts is None else study.warm_starts / path.relative_to(study.root)
+
+
+def _here_or_committed(study: Study, path: pathlib.Path) -> pathlib.Path:
+    """`path`, or its committed copy where --root lacks it: what a run goes on from (`_go_on_from_committed`)."""
+    committed = _committed(study, path)
+    return committed if not path.exists() and committed is not None and committed.exists() else path
+
+
 def save_in_progress(study: Study) -> list[pathlib.Path]:
-    """Copies each trunk run in --root that the study has not finished into study.warm_starts (the same layout), for
-    a session that keeps only what is committed to go on from (`trunk_workdir`): the run's record and metrics, the
-    exports that its unscored budgets start their cool-downs from, and its newest checkpoint while one of those
-    exports is still ahead of it. Removes the copies of runs finished since. Run it with the study stopped (a
-    checkpoint being written is not yet listed). Returns the runs copied."""
+    """Copies each run in --root that the study has not finished into study.warm_starts (the same layout), for a
+    session that keeps only what is committed to go on from (`trunk_workdir`, `cooldown_workdir`): a trunk's record
+    and metrics, the exports that its unscored budgets start their cool-downs from, and its newest checkpoint while
+    one of those exports is still ahead of it; a cool-down's record, metrics and newest checkpoint (its model instead
+    once exported). Removes the copies of runs finished since. Run it with the study stopped (a checkpoint being
+    written is not yet listed). Returns the runs copied."""
     from lipjax.train.checkpoint import CheckpointManager
 
     copied = []
@@ -278,30 +303,59 @@ def save_in_progress(study: Study) -> list[pathlib.Path]:
         lr = tuned_so_far(study, scene, trunk)
         if lr is None or not (workdir := run_dir(study.root, scene, trunk, lr, seed)).is_dir():
             continue
-        dest = run_dir(study.warm_starts, scene, trunk, lr, seed)
         methods = branches_of(trunk, study.methods)
+        unscored = {b: [m for m in methods if not scored(study, scene, m, seed, b)]
+                    for b in study.budgets_for(scene, seed)}
         starts = [trunk_export(study.root, scene, trunk, lr, seed, b - study.cooldown_images(b))
-                  for b in study.budgets_for(scene, seed)
-                  if not all(scored(study, scene, m, seed, b) for m in methods)]
+                  for b, left in unscored.items() if left]
         step = CheckpointManager(workdir / "checkpoints").latest_step()
         keep = [s.with_suffix(x) for s in starts for x in (".msgpack", ".json") if s.with_suffix(".msgpack").exists()]
         if step is not None and not all(s.with_suffix(".msgpack").exists() for s in starts):
             keep.append(workdir / "checkpoints" / str(step))
-        if dest.exists():
-            shutil.rmtree(dest)
-        if not keep:
-            continue
-        tmp = dest.with_name(dest.name + ".partial")
-        shutil.rmtree(tmp, ignore_errors=True)
-        for path in [p for p in workdir.iterdir() if p.is_file()] + keep:
-            target = tmp / path.relative_to(workdir)
-            target.parent.mkdir(parents=True, exist_ok=True)
-            (shutil.copytree if path.is_dir() else shutil.copy2)(path, target)
-        tmp.rename(dest)
-        copied.append(dest)
-        print(f"[study] {scene} {trunk} seed {seed}: kept in {dest} (" + ", ".join(
-            str(p.relative_to(workdir)) for p in keep) + ")", flush=True)
+        copied += _keep(study, workdir, keep)
+        for budget, left in unscored.items():
+            for method in methods:
+                cooldown = run_dir(study.root, scene, method, lr, seed) / str(budget)
+                if method not in left:
+                    _drop_committed(study, cooldown)  # finished since
+                if method not in left or not cooldown.is_dir():  # a copy of one not started here stays
+                    continue
+                model = cooldown / "model.msgpack"
+                step = CheckpointManager(cooldown / "checkpoints").latest_step()
+                copied += _keep(study, cooldown, [model, model.with_suffix(".json")] if model.exists()
+                                else [] if step is None else [cooldown / "checkpoints" / str(step)])
     return copied
+
+
+def _keep(study: Study, workdir: pathlib.Path, keep: list[pathlib.Path]) -> list[pathlib.Path]:
+    """Replaces the committed copy of `workdir` by its files (not its folders) and `keep` (paths inside it); none
+    where `keep` is empty. Returns [the copy] or []."""
+    dest = _committed(study, workdir)
+    _drop_committed(study, workdir)
+    if not keep:
+        return []
+    tmp = dest.with_name(dest.name + ".partial")
+    shutil.rmtree(tmp, ignore_errors=True)
+    for path in [p for p in workdir.iterdir() if p.is_file()] + keep:
+        target = tmp / path.relative_to(workdir)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        (shutil.copytree if path.is_dir() else shutil.copy2)(path, target)
+    tmp.rename(dest)
+    print(f"[study] {workdir.relative_to(study.root)}: kept in {dest} (" + ", ".join(
+        str(p.relative_to(workdir)) for p in keep) + ")", flush=True)
+    return [dest]
+
+
+def _drop_committed(study: Study, workdir: pathlib.Path) -> None:
+    """Removes the committed copy of `workdir` and the folders that this leaves empty."""
+    dest = _committed(study, workdir)
+    if dest is None or not dest.exists():
+        return
+    shutil.rmtree(dest)
+    for parent in dest.parents:
+        if parent == study.warm_starts or any(parent.iterdir()):
+            break
+        parent.rmdir()
 
 
 def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path, seed: int, budget: int,
@@ -312,7 +366,7 @@ def finish(study: Study, scene: str, method: str, lr: float, start: pathlib.Path
 
     config = with_workers(cooldown_config(method, scene, learning_rate=lr, seed=seed, init_from=str(start),
                                           images=study.cooldown_images(budget), tiny=study.tiny), study.workers)
-    model = run_dir(study.root, scene, method, lr, seed) / str(budget) / "model"
+    model = cooldown_workdir(study, scene, method, lr, seed, budget) / "model"
     if (why := stale_cooldown(config, model.parent)) is not None:
         shutil.rmtree(model.parent)
         print(f"[study] {model.parent} {why}: made again", flush=True)
@@ -427,7 +481,8 @@ def _done(study: Study, scene: str, trunk: str, seed: int, upto: int) -> bool:
 def images_left(study: Study, scene: str, trunk: str, seed: int, upto: int) -> dict[str, int]:
     """The training images plan step (scene, trunk, seed, upto) still needs, by method: the trunk's tuning (rates
     of TUNE_LRS not yet tried; its extensions cannot be foreseen) and its run on to the last export still needed,
-    and each cool-down whose model is not exported yet; runs part done count what their metrics.jsonl logged."""
+    and each cool-down whose model is not exported yet; runs part done (in --root, or committed to go on from) count
+    what their metrics.jsonl logged."""
     methods = branches_of(trunk, study.methods)
     left = dict.fromkeys(methods, 0)
     lr = tuned_so_far(study, scene, trunk)
@@ -438,16 +493,17 @@ def images_left(study: Study, scene: str, trunk: str, seed: int, upto: int) -> d
     for budget in [b for b in study.budgets_for(scene, seed) if b <= upto]:
         todo = [m for m in methods if not scored(study, scene, m, seed, budget)]
         start = budget - study.cooldown_images(budget)
-        if todo and (lr is None or not trunk_export(study.root, scene, trunk, lr, seed, start).with_suffix(
-                ".msgpack").exists()):
+        if todo and (lr is None or not _here_or_committed(study, trunk_export(
+                study.root, scene, trunk, lr, seed, start).with_suffix(".msgpack")).exists()):
             trunk_to = start
         for method in todo:
-            cooldown = None if lr is None else run_dir(study.root, scene, method, lr, seed) / str(budget)
+            cooldown = None if lr is None else _here_or_committed(
+                study, run_dir(study.root, scene, method, lr, seed) / str(budget))
             if cooldown is None or not (cooldown / "model.msgpack").exists():
                 left[method] += max(0, study.cooldown_images(budget) - _logged_images(cooldown))
     if trunk_to:
         left[trunk] += trunk_to - min(trunk_to, _logged_images(
-            None if lr is None else run_dir(study.root, scene, trunk, lr, seed)))
+            None if lr is None else _here_or_committed(study, run_dir(study.root, scene, trunk, lr, seed))))
     return left
 
 

@@ -111,6 +111,50 @@ def test_runs_in_progress_are_kept_with_their_newest_checkpoint_and_the_exports_
     assert sorted(p.name for p in kept[0].rglob("*")) == ["32.json", "32.msgpack", "models", "run.json"]
 
 
+def test_cool_downs_in_progress_are_kept_with_their_newest_checkpoint_and_a_new_machine_goes_on_from_them(tmp_path):
+    from lipjax.train.checkpoint import CheckpointManager
+
+    s = study(tmp_path / "a", warm_starts=tmp_path / "warm", seeds={"indoor": (0,)}, curve={"indoor": (32, 64)},
+              methods=("lip-cnn", "lip-ad"))
+    (s.scores / "indoor").mkdir(parents=True)
+    (s.scores / "indoor" / "tuning.json").write_text(json.dumps({"lip-cnn": tuned(16)}))
+    trunk = equal_budget.run_dir(s.root, "indoor", "lip-cnn", 5e-4, 0)
+    cooldowns = {m: equal_budget.run_dir(s.root, "indoor", m, 5e-4, 0) / "64" for m in ("lip-cnn", "lip-ad")}
+    (trunk / "models").mkdir(parents=True)
+    for suffix in (".msgpack", ".json"):  # the trunk's export at 64 - 32 images, where both cool-downs start
+        (trunk / "models" / f"32{suffix}").write_text("32")
+    for m, workdir in cooldowns.items():
+        workdir.mkdir(parents=True)
+        (workdir / "run.json").write_text(json.dumps({"method": m}))
+        (workdir / "metrics.jsonl").write_text(json.dumps({"step": 2, "images_per_s": 1.0}) + "\n")
+        for step in (1, 2):
+            CheckpointManager(workdir / "checkpoints").save(step, {"w": np.full(2, float(step))}, {"step": step})
+    (cooldowns["lip-ad"] / "model.msgpack").write_text("m")  # exported, not yet scored: its model is kept
+    (cooldowns["lip-ad"] / "model.json").write_text("{}")
+    for m in ("lip-cnn", "lip-ad"):  # budget 32 finished
+        equal_budget._write_json(equal_budget.result_path(s, "indoor", m, 0, 32), made(s, m, 5e-4))
+    done = equal_budget._committed(s, equal_budget.run_dir(s.root, "indoor", "lip-ad", 5e-4, 0) / "32")
+    (done / "checkpoints").mkdir(parents=True)  # kept by an earlier session, scored since
+
+    kept = equal_budget.save_in_progress(s)
+    warm = {m: equal_budget._committed(s, w) for m, w in cooldowns.items()}
+    assert kept == [equal_budget._committed(s, trunk), warm["lip-cnn"], warm["lip-ad"]] and not done.exists()
+    assert sorted(p.name for p in warm["lip-cnn"].iterdir()) == ["checkpoints", "metrics.jsonl", "run.json"]
+    assert [p.name for p in (warm["lip-cnn"] / "checkpoints").iterdir()] == ["2"]  # the newest only
+    assert sorted(p.name for p in warm["lip-ad"].iterdir()) == ["metrics.jsonl", "model.json", "model.msgpack",
+                                                                  "run.json"]
+    # a new machine: the plan counts the committed cool-down's logged steps, and the run goes on from its checkpoint
+    new = dataclasses.replace(s, root=tmp_path / "b")
+    assert equal_budget.images_left(new, "indoor", "lip-cnn", 0, 64) == {"lip-cnn": 32 - 16, "lip-ad": 0}
+    workdir = equal_budget.cooldown_workdir(new, "indoor", "lip-cnn", 5e-4, 0, 64)
+    state, meta = CheckpointManager(workdir / "checkpoints").restore({"w": np.zeros(2)})
+    assert meta == {"step": 2} and state["w"].tolist() == [2.0, 2.0]
+    # scored on the first machine: the copies go, and the trunk's export with them
+    for m in ("lip-cnn", "lip-ad"):
+        equal_budget._write_json(equal_budget.result_path(s, "indoor", m, 0, 64), made(s, m, 5e-4))
+    assert equal_budget.save_in_progress(s) == [] and list(s.warm_starts.iterdir()) == []
+
+
 def test_plan_counts_the_images_left_and_the_hours_at_the_rates_measured(tmp_path):
     import os
 
