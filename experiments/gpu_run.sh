@@ -6,18 +6,18 @@
 #       bash experiments/gpu_run.sh
 #
 # Runs the study under `timeout` (SIGTERM: the run in progress saves a checkpoint of its step and stops; SIGKILL 30 s
-# later if anything still runs) in runs/study, going on from the committed tuning, scores and trunks in progress
+# later if anything still runs) in runs/study, going on from the committed tuning, scores and runs in progress
 # (experiments/study_scores, experiments/warm_starts/study: in the working tree that travels), then packs into OUT:
 # log.txt, scores.tgz (the tuning and scores, and the report) and models.tgz.* (15 MB parts; the device tool brings
 # back 8 files and 64 MB at most, so give a call no more work than 4 parts hold: a trunk's checkpoint is ~17 MB):
-# every method's model at the budget IMAGES, and what this call wrote of the trunks it left unfinished
-# (--save-in-progress: each one's newest checkpoint and the exports its cool-downs still need).
+# every method's model at the budget IMAGES, and what this call wrote of the runs it left unfinished
+# (--save-in-progress: each trunk's and cool-down's newest checkpoint and the exports the cool-downs still need).
 # Back on the CPU machine, in the repository root:
 #
 #   tar xzf scores.tgz && cat models.tgz.* | tar xzf -     # then commit experiments/study_scores
 #
 # and the CPU study (python -m experiments.equal_budget) skips what the GPU finished and goes on from its unfinished
-# trunks where runs/study has no workdir of that trunk (remove the CPU's own, the study stopped, where the GPU's
+# runs where runs/study has no workdir of that run (remove the CPU's own, the study stopped, where the GPU's
 # checkpoint is further). TINY=1: the tiny check (tiny networks, 48x64 frames, a few images) in its own root,
 # scores and warm starts, runs/study-tiny, to test it on a CPU.
 set -u
