@@ -186,6 +186,12 @@ def frames(kind: str, size: tuple[int, int], variant, n: int):
     return list(SyntheticDataset(kind, "test", size=n, height=size[0], width=size[1], focal_range=focal))
 
 
+def rmse_unsampled(pred: np.ndarray, frame: Frame, sparse: np.ndarray) -> float:
+    """RMSE (m) of `pred` against the frame's depth on its valid pixels that hold no sample of `sparse`."""
+    keep = frame.valid & (sparse <= 0)
+    return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
+
+
 def ratio_to_linear(model, linear, frame, spec, cross_check: bool = CROSS_CHECK) -> float:
     """RMSE of `model` (name or path; None: the default path's choice) over that of `linear`, on the unsampled valid
     pixels, with the samples of `spec` (a sampler or its spec string, lipjax.data.sampling) drawn with seed 0;
@@ -198,15 +204,11 @@ def ratios_to_linear(model, linear, frame, spec, images, cross_check: bool = CRO
     """`ratio_to_linear` with each of `images` in place of the frame's own, the samples and the linear fill (which
     uses no image) computed once."""
     sparse = (sampler_from_spec(spec) if isinstance(spec, str) else spec)(frame, 0)
-    keep = frame.valid & (sparse <= 0)
-
-    def rmse(pred):
-        return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
-
-    completer, reference = get_completer(model, sparse=sparse), rmse(linear(frame.rgb, sparse))
+    completer = get_completer(model, sparse=sparse)
+    reference = rmse_unsampled(linear(frame.rgb, sparse), frame, sparse)
     flip = None if cross_check else False  # the default path, or the model alone
-    return [rmse(complete_frame(completer, rgb, sparse, flip=flip, cross_check=cross_check)) / reference
-            for rgb in images]
+    return [rmse_unsampled(complete_frame(completer, rgb, sparse, flip=flip, cross_check=cross_check), frame, sparse)
+            / reference for rgb in images]
 
 
 def geometric_mean(ratios) -> float:

@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 
+from benchmarks.common import rmse_unsampled
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.inference import Completer, complete_frame, frame_size, reproject_sparse
@@ -54,14 +55,13 @@ def main(argv=None) -> None:
         ratios, times, spacings = {k: [] for k in variants}, {k: [] for k in variants}, []
         for frame in SyntheticDataset(kind, "test", size=args.frames, height=h, width=w):
             sparse = sampler(frame, 0)
-            keep = frame.valid & (sparse <= 0)
-            ref = np.sqrt(np.mean((linear(frame.rgb, sparse)[keep] - frame.depth[keep]) ** 2))
+            ref = rmse_unsampled(linear(frame.rgb, sparse), frame, sparse)
             spacings.append(sample_spacing_px(reproject_sparse(sparse, frame_size(base, sparse))))
             for k, completer in variants.items():
                 t = time.perf_counter()
                 pred = complete_frame(completer, frame.rgb, sparse, flip=False, cross_check=False)
                 times[k].append(time.perf_counter() - t)
-                ratios[k].append(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)) / ref)
+                ratios[k].append(rmse_unsampled(pred, frame, sparse) / ref)
         gm = {k: float(np.exp(np.mean(np.log(r)))) for k, r in ratios.items()}
         ms = {k: 1e3 * float(np.median(t[1:] or t)) for k, t in times.items()}
         print(f"| {kind} {h}x{w} {spec} | {np.median(spacings):.1f} | {gm['linear']:.3f} | {gm['nearest']:.3f} | "

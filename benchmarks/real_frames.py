@@ -49,7 +49,8 @@ import time
 
 import numpy as np
 
-from benchmarks.common import GREY, REALDATA, frames_and_inputs, geometric_mean, hide_points, load_kitti
+from benchmarks.common import (GREY, REALDATA, frames_and_inputs, geometric_mean, hide_points, load_kitti,
+                               rmse_unsampled)
 from lipjax.data.frame import Frame
 from lipjax.data.sampling import LidarSampler
 from lipjax.inference import complete_at, complete_frame, frame_size
@@ -62,11 +63,6 @@ KITTI_LIDAR = LidarSampler.hdl64()  # the KITTI input's pattern (frames_and_inpu
 HIDDEN_BEAM_EVERY = 4  # every 4th scan line hidden
 HIDDEN_METHODS = ("linear", "ip_basic")
 CHECKS = ("dense ground truth", "hidden points", "hidden beams")
-
-
-def rmse(pred: np.ndarray, frame: Frame, sparse: np.ndarray) -> float:
-    keep = frame.valid & (sparse <= 0)
-    return float(np.sqrt(np.mean((pred[keep] - frame.depth[keep]) ** 2)))
 
 
 def summary(ratios: list[float]) -> str:
@@ -214,20 +210,20 @@ def frame_rows(inputs, args) -> list[dict]:
     for group, frame, sparse, input_name in inputs:
         completer = get_completer(args.model, sparse=sparse)
         grey = np.full_like(frame.rgb, GREY)
-        ref = rmse(linear(frame.rgb, sparse), frame, sparse)
+        ref = rmse_unsampled(linear(frame.rgb, sparse), frame, sparse)
         t0 = time.perf_counter()
         pred = complete_frame(completer, frame.rgb, sparse, flip=args.flip)
         ms = 1e3 * (time.perf_counter() - t0)
         row = {"group": group, "frame": frame.id, "input": input_name, "size": list(frame.shape),
                "model": completer.name, "working_size": list(frame_size(completer, sparse)),
-               "linear_rmse_m": ref, "default": rmse(pred, frame, sparse) / ref,
-               "grey": rmse(complete_frame(completer, grey, sparse, flip=args.flip), frame, sparse) / ref,
+               "linear_rmse_m": ref, "default": rmse_unsampled(pred, frame, sparse) / ref,
+               "grey": rmse_unsampled(complete_frame(completer, grey, sparse, flip=args.flip), frame, sparse) / ref,
                "ms": ms}
         for method in classical:
-            row[method.name] = rmse(method(frame.rgb, sparse), frame, sparse) / ref
+            row[method.name] = rmse_unsampled(method(frame.rgb, sparse), frame, sparse) / ref
         if args.sweep:
             spacing, lines = sample_spacing_px(sparse), is_lidar_pattern(sparse)
-            row["sweep"] = {str(t): rmse(complete_at(completer, frame.rgb, sparse, _sweep_size(
+            row["sweep"] = {str(t): rmse_unsampled(complete_at(completer, frame.rgb, sparse, _sweep_size(
                 frame.shape, spacing, t, lines), flip=args.flip), frame, sparse) / ref for t in SWEEP_TARGETS_PX}
         rows.append(row)
         print(f"{frame.id:32s} {input_name:20s} {row['model']:22s} work {row['working_size']} "

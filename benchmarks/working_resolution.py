@@ -27,6 +27,7 @@ import os
 
 import numpy as np
 
+from benchmarks.common import rmse_unsampled
 from lipjax.data.sampling import sampler_from_spec
 from lipjax.data.synthetic import SyntheticDataset
 from lipjax.inference import complete_at
@@ -49,11 +50,6 @@ MAX_PIXELS = (40_000, 60_000, 100_000, 150_000, 250_000, 1e12)  # 1e12: no pixel
 RULES = [(t, p) for t in TARGETS_PX for p in MAX_PIXELS]
 
 
-def rmse_unsampled(pred: np.ndarray, gt: np.ndarray, valid: np.ndarray, sparse: np.ndarray) -> float:
-    keep = valid & (sparse <= 0)
-    return float(np.sqrt(np.mean((pred[keep] - gt[keep]) ** 2)))
-
-
 def run(model: str, frames: int) -> dict:
     completer, linear = get_completer(model), get_completer("linear")
     table, scan_lines = {}, {}
@@ -63,13 +59,13 @@ def run(model: str, frames: int) -> dict:
         for frame in dataset:
             sparse = sampler(frame, 0)
             patterns.add(is_lidar_pattern(sparse))
-            ref = rmse_unsampled(linear(frame.rgb, sparse), frame.depth, frame.valid, sparse)
+            ref = rmse_unsampled(linear(frame.rgb, sparse), frame, sparse)
             spacing, by_size = sample_spacing_px(sparse), {}
             for t, p in RULES:
                 size = working_size((h, w), spacing, t, p)
                 if size not in by_size:  # rules that give the same size share one run
                     pred = complete_at(completer, frame.rgb, sparse, size, flip=False, cross_check=False)
-                    by_size[size] = rmse_unsampled(pred, frame.depth, frame.valid, sparse) / ref
+                    by_size[size] = rmse_unsampled(pred, frame, sparse) / ref
                 ratios[(t, p)].append(by_size[size])
         key = f"{kind} {h}x{w} {spec}"
         if len(patterns) > 1:
