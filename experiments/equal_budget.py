@@ -271,10 +271,9 @@ def cooldown_workdir(study: Study, scene: str, method: str, lr: float, seed: int
 def _go_on_from_committed(study: Study, workdir: pathlib.Path, name: str) -> pathlib.Path:
     """`workdir` (under --root), copied first from its committed copy (the same path under study.warm_starts) where
     --root lacks it and a copy exists."""
-    committed = _committed(study, workdir)
-    if not workdir.exists() and committed is not None and committed.is_dir():
-        shutil.copytree(committed, workdir)
-        print(f"[study] {name}: continuing from {committed}", flush=True)
+    if (source := _here_or_committed(study, workdir)) != workdir and source.is_dir():
+        shutil.copytree(source, workdir)
+        print(f"[study] {name}: continuing from {source}", flush=True)
     return workdir
 
 
