@@ -250,8 +250,8 @@ def _add_train_parser(sub) -> None:
     t = sub.add_parser("train", help="fine-tune a model on your folder of RGB-D frames")
     t.add_argument("--data", required=True, help="folder with rgb/ depth/ [sparse/] [intrinsics.txt, for a simulated "
                    "LiDAR only], or train/ and val/ holding them")
-    t.add_argument("--out", required=True, help="model path stem to export to, also the run's name (then: lipjax "
-                   "complete --model OUT)")
+    t.add_argument("--out", required=True, help="model path stem to export to; its name NAME is the "
+                   "run's (then: lipjax complete --model OUT)")
     t.add_argument("--depth-scale", type=depth_scale, metavar="S", help="PNG depth value per metre")
     t.add_argument("--init", help="model to start from: shipped name or saved path (default: the default model)")
     t.add_argument("--steps", type=console.positive_int, help=TRAIN_STEPS_HELP)
@@ -265,7 +265,7 @@ def _add_train_parser(sub) -> None:
                    "alone (no depth/): learn from a share HIDE (default 0.2) of each frame's samples hidden from it")
     t.add_argument("--keep", choices=("best", "last"), default="best", help="if the trained model validates worse "
                    "than its start: export the start (best, default) or the trained model anyway (last)")
-    t.add_argument("--workdir", help="checkpoints and logs (default runs/train-<--out name>)")
+    t.add_argument("--workdir", help="checkpoints and logs (default runs/train-NAME, self-supervised runs/adapt-NAME)")
     t.add_argument("-q", "--quiet", action="store_true", help="no progress bar or log lines")
     t.set_defaults(func=_cmd_train)
 
