@@ -8,16 +8,23 @@
 
 A killed run resumes from its last checkpoint when started again with the same workdir. The run writes only into
 its workdir (checkpoints, metrics.jsonl, curves.png); the model is exported only to --export PATH.
+
+Several hosts: the same command in every process, with --distributed (jax.distributed; on SLURM, Open MPI,
+Kubernetes or Cloud TPU nothing more, elsewhere also --coordinator HOST:PORT --num-processes N --process-id I);
+each process reads its slice of every batch, process 0 writes the logs, checkpoints and the export:
+
+    python -m experiments.train --config lip_cnn_indoor --distributed --coordinator node0:1234 --num-processes 2 \
+        --process-id 0 --workdir /shared/runs/lip_cnn_indoor --export /shared/models/lip-cnn   # 1 on the other
 """
 from __future__ import annotations
 
 import argparse
 import sys
 
-from lipjax.console import ArgumentParser, one_line, run_main
+from lipjax.console import ArgumentParser, one_line, positive_int, run_main
 from lipjax.train.config import parse_overrides
 from lipjax.train.run import run, soup
-from lipjax.utils import enable_compilation_cache
+from lipjax.utils import enable_compilation_cache, start_processes
 
 PROG = "python -m experiments.train"  # how it is run (also right as a script: no __spec__)
 
@@ -35,9 +42,22 @@ def main(argv=None) -> None:
                    help="export the mean parameters of saved models of one chain of warm starts, newest last "
                         "(model soup; validated on --config's validation set; trains nothing)")
     p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--distributed", action="store_true",
+                   help="one process of a run of several (hosts): jax.distributed, the cluster read from the "
+                        "environment where it can be (SLURM, Open MPI, Kubernetes, Cloud TPU)")
+    p.add_argument("--coordinator", metavar="HOST:PORT", help="with --distributed: process 0's address")
+    p.add_argument("--num-processes", type=positive_int, metavar="N", help="with --distributed: how many")
+    p.add_argument("--process-id", type=int, metavar="I", help="with --distributed: this process, 0 to N-1")
     args = p.parse_args(argv)
     if (args.export_only or args.soup) and args.export is None:
         p.error(f"{'--soup' if args.soup else '--export-only'} needs --export PATH")
+    cluster = {"coordinator": args.coordinator, "num_processes": args.num_processes, "process_id": args.process_id}
+    if not args.distributed and any(v is not None for v in cluster.values()):
+        p.error("--coordinator, --num-processes and --process-id need --distributed")
+    if args.distributed and (args.soup or args.export_only or args.average > 1):
+        p.error("--soup, --export-only and --average read saved models or checkpoints: run them without --distributed")
+    if args.distributed:
+        start_processes(**cluster)
     from experiments.configs import get_config
 
     try:

@@ -1,5 +1,5 @@
-"""Small process-level helpers: the persistent compilation cache, the CPU cores a process runs on, files written
-whole."""
+"""Small process-level helpers: the persistent compilation cache, the CPU cores a process runs on, a process of a
+multi-process run, files written whole."""
 from __future__ import annotations
 
 import contextlib
@@ -110,6 +110,16 @@ def limit_cpu_threads(n: int) -> set[int]:
         with contextlib.suppress(OSError):  # a thread that ended meanwhile
             os.sched_setaffinity(int(thread), cores)
     return cores
+
+
+def start_processes(coordinator: str | None = None, num_processes: int | None = None,
+                    process_id: int | None = None) -> None:
+    """Makes this process one of a run of several processes (hosts), before any other JAX call:
+    jax.distributed.initialize with the coordinator's address ("host:port" of process 0), the number of processes
+    and this one's index; each left None is read from the cluster's environment by JAX (SLURM, Open MPI,
+    Kubernetes, Cloud TPU). On CPU the processes reduce over gloo."""
+    jax.config.update("jax_cpu_collectives_implementation", "gloo")
+    jax.distributed.initialize(coordinator_address=coordinator, num_processes=num_processes, process_id=process_id)
 
 
 @contextlib.contextmanager

@@ -235,12 +235,16 @@ def test_host_initial_estimate_reaches_the_train_step(tmp_path, monkeypatch):
 MULTI_PROCESS_STEPS = 4
 
 
-def test_two_processes_match_one_process(straight_run, tmp_path):
+def _free_port() -> int:
     import socket
 
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
+        return s.getsockname()[1]
+
+
+def test_two_processes_match_one_process(straight_run, tmp_path):
+    port = _free_port()
     worker = os.path.join(os.path.dirname(__file__), "multiprocess_worker.py")
     out = tmp_path / "params.npz"
     procs = [subprocess.Popen([sys.executable, worker, str(i), str(port), str(tmp_path / "run"), str(out)],
@@ -259,6 +263,41 @@ def test_two_processes_match_one_process(straight_run, tmp_path):
         # Different reduction orders give float-level differences, which Adam turns into update-sized ones on
         # parameters whose gradient is ~0; 1e-5 is 1 % of one step (learning rate 1e-3).
         np.testing.assert_allclose(a, b, rtol=1e-4, atol=1e-5)
+
+
+def test_the_training_command_runs_as_two_processes(tmp_path):
+    """`python -m experiments.train --distributed` as 2 processes on localhost is one run: its 2 steps of batch 2
+    logged once, and one export, by process 0, of a model that has read 4 images (validated on its host copy of
+    the parameters: eval_every=0 leaves the last validation to the export)."""
+    port, workdir, model = _free_port(), tmp_path / "run", tmp_path / "model"
+
+    def command(process_id: int) -> list[str]:
+        return [sys.executable, "-m", "experiments.train", "--config", "smoke", "--distributed", "--coordinator",
+                f"127.0.0.1:{port}", "--num-processes", "2", "--process-id", str(process_id), "--workdir",
+                str(workdir), "--export", str(model), "--no-progress", "--set", "g_steps=2", "--set", "d_steps=0",
+                "--set", "adv_steps=0", "--set", "eval_every=0", "--set", "data.num_workers=0"]
+
+    procs = [subprocess.Popen(command(i), cwd=pathlib.Path(__file__).parents[1], stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True) for i in range(2)]
+    logs = [p.communicate(timeout=600)[0] for p in procs]
+    assert all(p.returncode == 0 for p in procs), "\n".join(log[-2000:] for log in logs)
+    assert "[lipjax] exported smoke (step 2)" in logs[0] and "exported" not in logs[1], logs
+    rows = [json.loads(line) for line in (workdir / "metrics.jsonl").read_text().splitlines()]
+    assert [r["step"] for r in rows if "phase" in r] == [2]
+    meta = lipjax.model_io.metadata(model)
+    assert (meta["steps"], meta["images_seen"]) == (2, 4) and np.isfinite(meta["val_metrics"]["rmse_m"])
+
+
+def test_the_training_command_checks_its_process_flags(capsys):
+    from experiments import train as train_command
+
+    for argv, says in ((["--process-id", "1"], "need --distributed"),
+                       (["--distributed", "--export-only", "--export", "m"], "run them without --distributed"),
+                       (["--distributed", "--average", "2"], "run them without --distributed")):
+        with pytest.raises(SystemExit) as exit_:
+            train_command.main(["--config", "smoke", *argv])
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert exit_.value.code == 2 and len(lines) == 1 and says in lines[0], lines
 
 
 MULTI_DEVICE_SCRIPT = textwrap.dedent(

@@ -238,8 +238,9 @@ def train(
     fine-tuning is to improve on.
 
     Data-parallel over all devices of `mesh` (default: every device): batches are sharded over the 'data' axis
-    and the state is replicated. Multi-host: call jax.distributed.initialize() first in every process; each
-    process loads its own slice of every global batch.
+    and the state is replicated. Multi-host: call lipjax.utils.start_processes (jax.distributed.initialize) first in
+    every process (`python -m experiments.train --distributed` does); each process loads its own slice of every
+    global batch.
     """
     workdir = pathlib.Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)

@@ -24,7 +24,7 @@ import numpy as np
 
 from lipjax import model_io
 from lipjax.interfaces import MIXED_SCENES
-from lipjax.train.checkpoint import CheckpointManager
+from lipjax.train.checkpoint import CheckpointManager, to_host
 from lipjax.train.config import TrainConfig
 from lipjax.train.curves import plot_curves
 from lipjax.train.folder import check_frames, default_init, fitted_to_folder, folder_config
@@ -136,11 +136,17 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
     scores. keep (KEEPS), when the start was validated and the end validates worse (a higher val RMSE): "best"
     exports the starting parameters instead (`kept_start`), "last" the end; either way the last line says so.
     Returns the validation metrics (metres) of what was exported (or trained, when nothing is).
+
+    Several processes (jax.distributed initialised, `start_processes`): every process trains; then process 0 alone
+    validates, plots and exports, from the parameters on its host, and the others return {}.
     """
     workdir = pathlib.Path(workdir)
     if average < 1:
         raise ValueError(f"--average {average}: give a number of checkpoints >= 1")
     check_keep(keep)
+    if jax.process_count() > 1 and (average > 1 or export_only):
+        raise ValueError("--average and --export-only read checkpoints, not a run of several processes: run them in "
+                         "one process")
     if export is not None:
         check_writable(pathlib.Path(export).parent, "the model (--out / --export)")
     if config.data.source == "folder" and not export_only:
@@ -156,6 +162,10 @@ def run(config: TrainConfig, workdir: str | os.PathLike, *, export: str | os.Pat
         manager.close()
     else:
         state = train(config, workdir, progress=progress, validate_start=validate_start)
+    if jax.process_count() > 1:
+        state = jax.tree_util.tree_map(to_host, state)  # each process holds a whole copy of the replicated state
+        if jax.process_index() != 0:
+            return {}
     averaged = {}
     if average > 1:
         params, steps = averaged_params(config, workdir, jax.device_get(state), average)
