@@ -25,7 +25,7 @@ CONFIGS: dict[str, TrainConfig] = {
     "lip_any": LIP_ANY,
 }
 
-# What the shipped weights reached (lipjax/weights/<name>.json); all trained on --set data.source=rendered.
+# What the shipped weights reached (lipjax/weights/<name>.json; the data each run read: its data_streams).
 EXPECTED: dict[str, Expected] = {
     "lip_any": Expected(
         val_rmse_m=2.081812, images_seen=1_572_640, budget_from_config=False,
