@@ -7,11 +7,14 @@ live in `lipjax/weights/` and load by name, e.g. `load("lip-cnn-indoor")`.
 
 The stem is used as given: `save("out/smoke.v2", ...)` writes `out/smoke.v2.json` and `out/smoke.v2.msgpack`.
 `load` checks both files and raises ModelFileError (one line, naming the file and the fix) when either is
-unreadable, truncated, holds a bad config field, or when the parameters do not fit the config.
+unreadable, truncated, holds a bad config field, when the parameters do not fit the config, or when the JSON's
+`params_sha256` (the SHA-256 of the .msgpack that `save` wrote beside it) is not the .msgpack's: the parameters of
+another save of the same architecture, or bytes changed since.
 """
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import os
 import pathlib
@@ -100,8 +103,10 @@ def save(stem: str | os.PathLike, config, params, metadata: dict | None = None) 
     stem = pathlib.Path(stem)
     stem.parent.mkdir(parents=True, exist_ok=True)
     params = jax.tree_util.tree_map(np.asarray, params)
-    _atomic_write(_with_suffix(stem, ".msgpack"), flax.serialization.msgpack_serialize(params))
-    doc = {"config": config_to_dict(config), "metadata": metadata or {}}
+    packed = flax.serialization.msgpack_serialize(params)
+    _atomic_write(_with_suffix(stem, ".msgpack"), packed)
+    doc = {"config": config_to_dict(config), "params_sha256": hashlib.sha256(packed).hexdigest(),
+           "metadata": metadata or {}}
     _atomic_write(_with_suffix(stem, ".json"), json.dumps(doc, indent=2).encode())
 
 
@@ -186,8 +191,9 @@ def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:
         config = config_from_dict(doc["config"])
     except (ValueError, TypeError, KeyError, AttributeError) as exc:  # JSONDecodeError is a ValueError
         raise ModelFileError(f"{json_path}: not a valid lipjax model config ({_describe(exc)}); {fix}") from exc
+    packed = msgpack_path.read_bytes()
     try:
-        params = flax.serialization.msgpack_restore(msgpack_path.read_bytes())
+        params = flax.serialization.msgpack_restore(packed)
     except Exception as exc:  # noqa: BLE001 - msgpack raises several types for damaged data
         raise ModelFileError(f"{msgpack_path}: cannot read the parameters, the file is damaged or truncated "
                              f"({_describe(exc)}); {fix}") from exc
@@ -196,6 +202,10 @@ def load(name_or_path: str | os.PathLike) -> tuple[object, dict, dict]:
     if mismatch:
         raise ModelFileError(f"{msgpack_path} does not match {json_path.name} ({mismatch}): the two files come "
                              f"from different models; {fix}")
+    digest = hashlib.sha256(packed).hexdigest()
+    if doc.get("params_sha256", digest) != digest:  # a model saved before 2026-12-08 has none
+        raise ModelFileError(f"{msgpack_path} is not the parameter file saved with {json_path.name} (its SHA-256 "
+                             f"is not params_sha256): changed since, or from another save; {fix}")
     return config, params, doc.get("metadata", {})
 
 

@@ -155,6 +155,8 @@ def test_max_side_runs_downsized_and_keeps_measured_pixels_exact(model, frame, t
                              "the file holds ['encoder'])"),
     ("model_json_bad_field", "bad.json: not a valid lipjax model config (TypeError: "),
     ("model_file_truncated", "bad.msgpack: cannot read the parameters, the file is damaged or truncated"),
+    ("model_files_swapped", "bad.msgpack is not the parameter file saved with bad.json (its SHA-256 is not "
+                            "params_sha256)"),
     ("depth_as_rgb", "A 16-bit single-channel PNG is a depth map, not a colour image"),
     ("no_depth", "give the sparse depth as --depth SPARSE, or a LiDAR sweep as --lidar SWEEP --calib FILE"),
 ])
@@ -205,6 +207,9 @@ def _broken_model(case, model, stem):
         doc["config"]["num_iterationz"] = 2
     if case == "model_file_truncated":
         params = params[: len(params) // 2]
+    if case == "model_files_swapped":  # the same architecture's parameters from another save: every value moved
+        model_io.save(stem.with_name("other"), CONFIG, jax.tree_util.tree_map(lambda a: a + 1, model_io.load(good)[1]))
+        params = stem.with_name("other.msgpack").read_bytes()
     stem.with_name("bad.json").write_text(json.dumps(doc))
     stem.with_name("bad.msgpack").write_bytes(params)
     return str(stem)

@@ -1,6 +1,7 @@
 """The named training configs (experiments/configs/): each shipped model reached what its config states, each
 config is at most one `dataclasses.replace` from a scene base, and `--set` overrides live in the library."""
 import dataclasses
+import hashlib
 import importlib
 import json
 import pathlib
@@ -18,8 +19,9 @@ from lipjax.train.folder import folder_config
 
 
 def _shipped_docs() -> dict[str, dict]:
-    """Config key -> the model file's document, for every shipped model whose metadata names its train_config."""
-    docs = [json.loads((WEIGHTS_DIR / f"{name}.json").read_text()) for name in available()]
+    """Config key -> the model file's document (and its "name", the shipped name), for every shipped model whose
+    metadata names its train_config."""
+    docs = [{**json.loads((WEIGHTS_DIR / f"{name}.json").read_text()), "name": name} for name in available()]
     return {doc["metadata"]["train_config"].replace("-", "_"): doc for doc in docs
             if "train_config" in doc.get("metadata", {})}
 
@@ -32,10 +34,14 @@ def test_every_shipped_model_has_an_expected_result_and_every_expected_result_a_
 
 @pytest.mark.parametrize("key", sorted(_shipped_docs()))
 def test_shipped_model_reached_its_configs_expected_result(key):
+    """The model file records the validation RMSE its weights scored when shipped (ship_study, or the run's
+    export), and that is the config's EXPECTED result; the weights are still those (the JSON's params_sha256, which
+    lipjax.model_io.load checks too, is the SHA-256 of the .msgpack beside it)."""
     doc, config, expected = _shipped_docs()[key], CONFIGS[key], EXPECTED[key]
     meta = doc["metadata"]
     assert meta["train_config"] == config.name
     assert meta["val_metrics"]["rmse_m"] == pytest.approx(expected.val_rmse_m, rel=1e-6)
+    assert doc["params_sha256"] == hashlib.sha256((WEIGHTS_DIR / f"{doc['name']}.msgpack").read_bytes()).hexdigest()
     assert meta["images_seen"] == expected.images_seen
     # validated as the config validates, so the RMSE is the config's to state
     assert (meta["val_sampler"], meta["val_images"]) == (config.data.val_sampler, config.data.val_images)

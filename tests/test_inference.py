@@ -1,5 +1,8 @@
 """The public inference entry point: clear input errors, batching, compile-once, save/load round trip."""
 
+import hashlib
+import json
+
 import jax
 import numpy as np
 import pytest
@@ -97,6 +100,9 @@ def test_save_and_load_round_trip(tmp_path, scrambled):
         np.testing.assert_array_equal(np.asarray(a), np.asarray(b))
     rgb, sparse = _inputs()
     np.testing.assert_array_equal(loaded(rgb, sparse), scrambled(rgb, sparse))
+    # the JSON names the parameter file's bytes (hashlib, independently of model_io), which load checks
+    doc = json.loads((tmp_path / "m.json").read_text())
+    assert doc["params_sha256"] == hashlib.sha256((tmp_path / "m.msgpack").read_bytes()).hexdigest()
 
 
 def test_unknown_model_name_lists_available():
