@@ -48,12 +48,37 @@ def test_zoomed_samples_land_on_their_own_ground_truth(zoom):
     assert measured.sum() > 20
     if zoom > 1:  # one old pixel covers several new ones: the sample lands inside its own pixel's footprint
         np.testing.assert_array_equal(out.sparse[measured], out.gt[measured])
+    else:
+        for i in range(3):
+            _check_shrunk_samples(b.sparse[i], b.gt[i], out.sparse[i], out.gt[i], zoom)
     # each example's samples are its frame's moved into one window of the frame (move_samples: where several land
     # in one new pixel, the nearest wins); the window's corner is drawn, so look for it among all the corners
     for i in range(3):
         corners = [(t, l) for t in range(60) for l in range(64) if np.array_equal(
             out.sparse[i], move_samples(b.sparse[i], t, l, zoom, (32, 40)))]
         assert len(corners) >= 1 and all(t + 32 / zoom <= 60 and l + 40 / zoom <= 64 for t, l in corners)
+
+
+def _check_shrunk_samples(sparse, gt, new_sparse, new_gt, s):
+    """Zoom s < 1: new pixel x covers the old pixels r with floor((r + 0.5 - top) * s) = x (its footprint), and its
+    ground truth is the old one nearest its centre, at old coordinate (x + 0.5) / s + top - 0.5. The window's corner
+    is found from the ground truth alone; then each new pixel holds the nearest of the samples in its footprint,
+    and its ground truth comes from that footprint too (for s = 0.8 no centre falls half-way between two pixels)."""
+    h, w = new_gt.shape
+    near_r, near_c = (np.round((np.arange(n) + 0.5) / s - 0.5).astype(int) for n in (h, w))
+    corners = [(t, l) for t in range(gt.shape[0] - near_r[-1]) for l in range(gt.shape[1] - near_c[-1])
+               if np.array_equal(new_gt, gt[np.ix_(near_r + t, near_c + l)])]
+    assert len(corners) == 1
+    top, left = corners[0]
+    for x in range(h):
+        rows = [r for r in range(gt.shape[0]) if np.floor((r + 0.5 - top) * s) == x]
+        assert near_r[x] + top in rows
+        for y in range(w):
+            cols = [c for c in range(gt.shape[1]) if np.floor((c + 0.5 - left) * s) == y]
+            assert near_c[y] + left in cols
+            footprint = sparse[np.ix_(rows, cols)]
+            samples = footprint[footprint > 0]
+            assert new_sparse[x, y] == (samples.min() if samples.size else 0.0)
 
 
 def test_move_samples_keeps_the_nearest_where_samples_collide():

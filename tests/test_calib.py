@@ -281,6 +281,18 @@ def _street_calib(path, tr=TR, k=SK):
     return path
 
 
+def _devkit_projection(sweep_path, tr=TR, k=SK, shape=(SH, SW)):
+    """(the sweep's point count, the pixels of the (H, W) image that get a point) by the devkit's formula, u, v, w =
+    P2 @ R0_rect @ Tr_velo_to_cam @ [p; 1] (P2 = k @ [I | camera 2's offset]), independently of project_sweep."""
+    sweep = np.fromfile(sweep_path, np.float32).reshape(-1, 4)
+    uvw = k @ np.c_[np.eye(3), OFFSETS[2]] @ _pad(R0) @ _pad(tr) @ np.c_[sweep[:, :3], np.ones(len(sweep))].T
+    col, row = np.floor(uvw[0] / uvw[2] + 0.5), np.floor(uvw[1] / uvw[2] + 0.5)
+    inside = (uvw[2] > 0) & (col >= 0) & (col < shape[1]) & (row >= 0) & (row < shape[0])
+    hit = np.zeros(shape, bool)
+    hit[row[inside].astype(int), col[inside].astype(int)] = True
+    return len(sweep), hit
+
+
 def _warnings_of(fn, *args, **kwargs):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -292,7 +304,8 @@ def test_a_sweep_with_its_calibration_projects_without_a_warning(tmp_path):
     sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
     assert _warnings_of(project_sweep, sweep, calib, (SH, SW), image_path=tmp_path / "image_2" / "000000.png") == []
     _, _, counts = project_sweep(sweep, calib, (SH, SW), return_counts=True)
-    assert counts.points == 22856 and counts.kept == 3253  # 14 % of the sweep, as on KITTI
+    points, hit = _devkit_projection(sweep)
+    assert (counts.points, counts.kept) == (points, hit.sum()) and 0.05 < counts.kept / counts.points < 0.2
 
 
 def test_an_inverted_transform_warns_that_the_points_lie_on_one_side(tmp_path):
@@ -300,10 +313,15 @@ def test_an_inverted_transform_warns_that_the_points_lie_on_one_side(tmp_path):
     the image, completed as "indoor input"; its points lie mostly left of the image's centre (the road turns into
     the image's left half), which warns."""
     sweep = _street_sweep(tmp_path / "000000.bin")
-    calib = _street_calib(tmp_path / "calib.txt", tr=np.linalg.inv(_pad(TR))[:3])
+    inverted = np.linalg.inv(_pad(TR))[:3]
+    calib = _street_calib(tmp_path / "calib.txt", tr=inverted)
+    _, hit = _devkit_projection(sweep, tr=inverted)
+    right = np.mean(np.nonzero(hit)[1] > SK[0, 2])  # the share of the kept points right of the principal point
+    assert right < 0.25
     assert _warnings_of(project_sweep, sweep, calib, (SH, SW)) == [
-        f"{sweep}: only 19 % of its 1553 points in the image lie in its right half, where a calibrated camera sees "
-        f"about half: is the transform in {calib} inverted (camera to LiDAR, not LiDAR to camera) or another rig's?"]
+        f"{sweep}: only {100 * right:.0f} % of its {hit.sum()} points in the image lie in its right half, where a "
+        f"calibrated camera sees about half: is the transform in {calib} inverted (camera to LiDAR, not LiDAR to "
+        "camera) or another rig's?"]
 
 
 def test_an_image_of_another_size_than_the_calibrations_warns(tmp_path):
@@ -314,11 +332,13 @@ def test_an_image_of_another_size_than_the_calibrations_warns(tmp_path):
     assert _warnings_of(project_sweep, sweep, calib, (SH // 2, SW // 2)) == [
         f"{calib}: camera 2's principal point (79.5, 23.5) lies far from the centre (39.5, 11.5) of the 80x24 image: "
         "was the image resized or cropped? resize or shift fx, fy, cx, cy with it"]
-    zoomed = _street_calib(tmp_path / "zoomed.txt", k=SK * [[10], [10], [1]] + [[0, 0, -9 * 79.5], [0, 0, -9 * 23.5],
-                                                                                 [0, 0, 0]])
+    zoom_k = SK * [[10], [10], [1]] + [[0, 0, -9 * 79.5], [0, 0, -9 * 23.5], [0, 0, 0]]  # principal point kept
+    zoomed = _street_calib(tmp_path / "zoomed.txt", k=zoom_k)
+    points, hit = _devkit_projection(sweep, k=zoom_k)
+    assert 0 < hit.sum() < 0.02 * points
     assert _warnings_of(project_sweep, sweep, zoomed, (SH, SW)) == [
-        f"{sweep}: only 67 of its 22856 points land in the 160x48 image (under 2 %): was the image resized or "
-        f"cropped, or is {zoomed} another sweep's calibration?"]
+        f"{sweep}: only {hit.sum()} of its {points} points land in the 160x48 image (under 2 %): was the image "
+        f"resized or cropped, or is {zoomed} another sweep's calibration?"]
 
 
 def test_the_camera_named_by_the_images_folder_must_be_the_one_chosen(tmp_path):

@@ -33,6 +33,7 @@ def _leafy(n: int) -> list[int]:
 
 
 def test_every_large_foliage_sphere_becomes_clumps_inside_it_and_nothing_else_changes():
+    replaced = 0
     for index in range(4):
         street = _street(index)
         porous = porous_foliage(street, np.random.default_rng(index))
@@ -43,6 +44,7 @@ def test_every_large_foliage_sphere_becomes_clumps_inside_it_and_nothing_else_ch
                 assert q is p  # the same primitive object: untouched
                 continue
             assert q.mat is p.mat and q.asm == p.asm and q.cast == p.cast and len(q.rs) > len(p.rs)
+            replaced += 1
             # each clump lies inside the sphere it replaces: |c' - c| + r' <= R for some big sphere (c, R)
             inside = (np.linalg.norm(q.cs[:, None, :].astype(np.float64) - p.cs[None].astype(np.float64), axis=2)
                       + q.rs[:, None] <= p.rs[None] * (1 + 1e-5) + 1e-6)
@@ -52,6 +54,7 @@ def test_every_large_foliage_sphere_becomes_clumps_inside_it_and_nothing_else_ch
                 assert np.any(np.all(q.cs == c, axis=1) & (q.rs == r))
         again = porous_foliage(_street(index), np.random.default_rng(index))
         assert all(np.array_equal(a.cs, b.cs) for a, b in zip(porous.prims, again.prims) if isinstance(a, _Spheres))
+    assert replaced > 0  # the streets hold large foliage spheres: the checks above ran
 
 
 def test_a_porous_street_is_seen_through_its_foliage_and_nowhere_else_moves():

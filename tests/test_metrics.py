@@ -79,7 +79,7 @@ def test_non_positive_predictions_clamped_only_for_ratio_and_inverse():
     assert m["delta3_pct"] == 0.0
     expected_inv = np.array([1000 / 1e-3 - 1000 / 2, 1000 / 1e-3 - 1000 / 4])
     assert m["imae_1_per_km"] == pytest.approx(expected_inv.mean())
-    assert math.isfinite(m["irmse_1_per_km"])
+    assert m["irmse_1_per_km"] == pytest.approx(np.sqrt(np.mean(expected_inv**2)))
 
 
 def test_nan_prediction_and_bad_shapes_raise():

@@ -92,6 +92,12 @@ def test_per_pixel_rho_is_the_minimiser_of_the_pixelwise_weighted_objective():
 
 
 def test_dual_update():
+    """u_{k+1} = u_k + x_{k+1} - z_{k+1}: by hand (1 + 3 - 5 = -1), and from u_0 = 0 the dual after K steps is the
+    running sum of the residuals x_k - z_k."""
+    assert float(dual_update(np.float32(1.0), np.float32(3.0), np.float32(5.0))) == -1.0
     rng = np.random.default_rng(4)
-    u, x, z = (rng.normal(size=(2, 3)).astype(np.float32) for _ in range(3))
-    np.testing.assert_allclose(dual_update(u, x, z), u + x - z)
+    xs, zs = (rng.normal(size=(5, 2, 3)).astype(np.float32) for _ in range(2))
+    u = np.zeros((2, 3), np.float32)
+    for x, z in zip(xs, zs):
+        u = dual_update(u, x, z)
+    np.testing.assert_allclose(u, (xs - zs).sum(axis=0), rtol=1e-5, atol=1e-6)

@@ -236,7 +236,7 @@ def test_support_mask_follows_its_rule_in_pixels():
     assert s == pytest.approx(math.sqrt(39 * 59 / np.count_nonzero(sparse))) and 3 * s == pytest.approx(7.2, abs=0.1)
     top_kept = 20 - math.floor(s)
     assert mask[top_kept:, 0].all() and not mask[:top_kept, :].any()  # 1 spacing above the top line, no higher
-    assert not mask[39, 30] and not mask[36, 30] and mask[35, 30]  # 10, 8 and 7 px from the nearest line (row 28)
+    assert not mask[39, 30] and not mask[36, 30] and mask[35, 30]  # 11, 8 and 7 px from the nearest line (row 28)
     assert mask[sparse > 0].all()
     depth = np.full(sparse.shape, 9.0, np.float32)
     masked = uncertainty.mask_unsupported(depth, sparse)
