@@ -117,6 +117,20 @@ def test_the_docs_rig_example_reads_as_text_and_as_yaml(tmp_path, name):
     np.testing.assert_array_equal(t, expected)
 
 
+def _devkit_projection(sweep_path, k, shape, tr=TR):
+    """(the (H, W) depth of the nearest point per pixel, 0 elsewhere; the sweep's point count; the points that land
+    in the image) by the devkit's formula, u, v, w = P2 @ R0_rect @ Tr_velo_to_cam @ [p; 1] with P2 = k @ [I |
+    camera 2's offset], independently of project_sweep."""
+    sweep = np.fromfile(sweep_path, np.float32).reshape(-1, 4)
+    uvw = k @ np.c_[np.eye(3), OFFSETS[2]] @ _pad(R0) @ _pad(tr) @ np.c_[sweep[:, :3], np.ones(len(sweep))].T
+    col, row, w = np.floor(uvw[0] / uvw[2] + 0.5), np.floor(uvw[1] / uvw[2] + 0.5), uvw[2]
+    inside = (w > 0) & (col >= 0) & (col < shape[1]) & (row >= 0) & (row < shape[0])
+    depth = np.full(shape, np.inf)
+    np.minimum.at(depth, (row[inside].astype(int), col[inside].astype(int)), w[inside])
+    depth[np.isinf(depth)] = 0
+    return depth, len(sweep), int(inside.sum())
+
+
 def test_projection_agrees_pixel_for_pixel_with_the_devkit_formula(tmp_path):
     """2000 points (some outside the image, some behind, many sharing a pixel) projected by project_sweep from a
     written calib file and a .bin sweep, and independently as u, v, w = P2 @ R0_rect @ Tr_velo_to_cam @ [p; 1]
@@ -131,15 +145,9 @@ def test_projection_agrees_pixel_for_pixel_with_the_devkit_formula(tmp_path):
     sweep.tofile(tmp_path / "000000.bin")
     sparse, intrinsics = project_sweep(tmp_path / "000000.bin", write_object_calib(tmp_path / "calib.txt"), (H, W))
 
-    homogeneous = np.c_[sweep[:, :3].astype(np.float64), np.ones(n)].T
-    uvw = P[2] @ _pad(R0) @ _pad(TR) @ homogeneous
-    col, row, w = np.floor(uvw[0] / uvw[2] + 0.5), np.floor(uvw[1] / uvw[2] + 0.5), uvw[2]
-    inside = (w > 0) & (col >= 0) & (col < W) & (row >= 0) & (row < H)
-    expected = np.full((H, W), np.inf)
-    np.minimum.at(expected, (row[inside].astype(int), col[inside].astype(int)), w[inside])
-    expected[np.isinf(expected)] = 0
+    expected, _, inside = _devkit_projection(tmp_path / "000000.bin", K, (H, W))
     assert _matrix(intrinsics).tolist() == K.tolist()
-    assert 500 < (expected > 0).sum() < inside.sum()  # many pixels, and some shared by several points
+    assert 500 < (expected > 0).sum() < inside  # many pixels, and some shared by several points
     np.testing.assert_array_equal(sparse > 0, expected > 0)
     np.testing.assert_allclose(sparse, expected, rtol=1e-6)
 
@@ -281,18 +289,6 @@ def _street_calib(path, tr=TR, k=SK):
     return path
 
 
-def _devkit_projection(sweep_path, tr=TR, k=SK, shape=(SH, SW)):
-    """(the sweep's point count, the pixels of the (H, W) image that get a point) by the devkit's formula, u, v, w =
-    P2 @ R0_rect @ Tr_velo_to_cam @ [p; 1] (P2 = k @ [I | camera 2's offset]), independently of project_sweep."""
-    sweep = np.fromfile(sweep_path, np.float32).reshape(-1, 4)
-    uvw = k @ np.c_[np.eye(3), OFFSETS[2]] @ _pad(R0) @ _pad(tr) @ np.c_[sweep[:, :3], np.ones(len(sweep))].T
-    col, row = np.floor(uvw[0] / uvw[2] + 0.5), np.floor(uvw[1] / uvw[2] + 0.5)
-    inside = (uvw[2] > 0) & (col >= 0) & (col < shape[1]) & (row >= 0) & (row < shape[0])
-    hit = np.zeros(shape, bool)
-    hit[row[inside].astype(int), col[inside].astype(int)] = True
-    return len(sweep), hit
-
-
 def _warnings_of(fn, *args, **kwargs):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -304,8 +300,9 @@ def test_a_sweep_with_its_calibration_projects_without_a_warning(tmp_path):
     sweep, calib = _street_sweep(tmp_path / "000000.bin"), _street_calib(tmp_path / "calib.txt")
     assert _warnings_of(project_sweep, sweep, calib, (SH, SW), image_path=tmp_path / "image_2" / "000000.png") == []
     _, _, counts = project_sweep(sweep, calib, (SH, SW), return_counts=True)
-    points, hit = _devkit_projection(sweep)
-    assert (counts.points, counts.kept) == (points, hit.sum()) and 0.05 < counts.kept / counts.points < 0.2
+    depth, points, _ = _devkit_projection(sweep, SK, (SH, SW))
+    assert (counts.points, counts.kept) == (points, np.count_nonzero(depth))
+    assert 0.05 < counts.kept / counts.points < 0.2
 
 
 def test_an_inverted_transform_warns_that_the_points_lie_on_one_side(tmp_path):
@@ -315,11 +312,12 @@ def test_an_inverted_transform_warns_that_the_points_lie_on_one_side(tmp_path):
     sweep = _street_sweep(tmp_path / "000000.bin")
     inverted = np.linalg.inv(_pad(TR))[:3]
     calib = _street_calib(tmp_path / "calib.txt", tr=inverted)
-    _, hit = _devkit_projection(sweep, tr=inverted)
-    right = np.mean(np.nonzero(hit)[1] > SK[0, 2])  # the share of the kept points right of the principal point
+    depth, _, _ = _devkit_projection(sweep, SK, (SH, SW), tr=inverted)
+    kept = np.count_nonzero(depth)
+    right = np.mean(np.nonzero(depth)[1] > SK[0, 2])  # the share of the kept points right of the principal point
     assert right < 0.25
     assert _warnings_of(project_sweep, sweep, calib, (SH, SW)) == [
-        f"{sweep}: only {100 * right:.0f} % of its {hit.sum()} points in the image lie in its right half, where a "
+        f"{sweep}: only {100 * right:.0f} % of its {kept} points in the image lie in its right half, where a "
         f"calibrated camera sees about half: is the transform in {calib} inverted (camera to LiDAR, not LiDAR to "
         "camera) or another rig's?"]
 
@@ -334,10 +332,11 @@ def test_an_image_of_another_size_than_the_calibrations_warns(tmp_path):
         "was the image resized or cropped? resize or shift fx, fy, cx, cy with it"]
     zoom_k = SK * [[10], [10], [1]] + [[0, 0, -9 * 79.5], [0, 0, -9 * 23.5], [0, 0, 0]]  # principal point kept
     zoomed = _street_calib(tmp_path / "zoomed.txt", k=zoom_k)
-    points, hit = _devkit_projection(sweep, k=zoom_k)
-    assert 0 < hit.sum() < 0.02 * points
+    depth, points, _ = _devkit_projection(sweep, zoom_k, (SH, SW))
+    kept = np.count_nonzero(depth)
+    assert 0 < kept < 0.02 * points
     assert _warnings_of(project_sweep, sweep, zoomed, (SH, SW)) == [
-        f"{sweep}: only {hit.sum()} of its {points} points land in the 160x48 image (under 2 %): was the image "
+        f"{sweep}: only {kept} of its {points} points land in the 160x48 image (under 2 %): was the image "
         f"resized or cropped, or is {zoomed} another sweep's calibration?"]
 
 
